@@ -1,0 +1,33 @@
+//! A ternary qualitative calculus over point triples `AB:C`: its base relations, a classifier,
+//! the unary operators LEFT, RIGHT, INVERSE and composition (000 §III). The map, measurement
+//! and reasoning code is written once against [`Calculus`] and serves EDC and FDC alike.
+
+mod operators;
+mod relation_set;
+mod table_format;
+
+pub use operators::{OperatorTables, UnaryOperator};
+pub use relation_set::{ParseRelationSetError, RelationSet};
+pub use table_format::{CompositionEntry, CompositionFile, EntryKind, TableFormatError, UnaryFile};
+
+use crate::geometry::Point;
+
+/// A point-based ternary calculus with generated operator tables.
+pub trait Calculus: Send + Sync + 'static {
+    /// Short name used in file headers and on the command line (`EDC`, `FDC`).
+    const NAME: &'static str;
+    /// Number of base relations, numbered `1..=RELATIONS`.
+    const RELATIONS: u8;
+
+    /// The base relation of `c` with respect to the directed pair `a → b`, or `None` when it is
+    /// not defined (for EDC: `c` on a boundary; for any calculus: `a == b`).
+    fn classify(a: Point, b: Point, c: Point) -> Option<u8>;
+
+    /// The committed operator tables.
+    fn tables() -> &'static OperatorTables;
+
+    /// The universal relation: nothing known.
+    fn universe() -> RelationSet {
+        RelationSet::all(Self::RELATIONS as usize)
+    }
+}

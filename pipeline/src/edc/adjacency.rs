@@ -1,0 +1,171 @@
+//! Which EDC regions touch: share a boundary edge or a vertex (000 §VIII-A counts open states
+//! "not adjacent" to the true one). Derived from the geometry, not typed in: walk every boundary
+//! curve of the canonical frame, find the vertices where other boundaries cross it, and look at
+//! the regions just beside each curve close to each vertex. Every boundary edge ends in a
+//! vertex, so regions sharing an edge also meet at a vertex.
+
+use super::region::classify;
+use crate::calculus::RelationSet;
+use crate::geometry::{boundary_values, Point};
+use std::f64::consts::TAU;
+
+/// A boundary curve of the frame A=(0,0), B=(0,1), as a parametrisation with unit normal.
+#[derive(Clone, Copy)]
+enum Curve {
+    /// x = 0.
+    LineAB,
+    /// y = c.
+    Horizontal(f64),
+    /// Unit circle about (0, c).
+    Circle(f64),
+}
+
+impl Curve {
+    const ALL: [Curve; 6] = [
+        Curve::LineAB,
+        Curve::Horizontal(0.0),
+        Curve::Horizontal(1.0),
+        Curve::Horizontal(0.5),
+        Curve::Circle(0.0),
+        Curve::Circle(1.0),
+    ];
+
+    fn point(self, t: f64) -> Point {
+        match self {
+            Curve::LineAB => Point::new(0.0, t),
+            Curve::Horizontal(c) => Point::new(t, c),
+            Curve::Circle(c) => Point::new(t.cos(), c + t.sin()),
+        }
+    }
+
+    fn normal(self, t: f64) -> Point {
+        match self {
+            Curve::LineAB => Point::new(1.0, 0.0),
+            Curve::Horizontal(_) => Point::new(0.0, 1.0),
+            Curve::Circle(_) => Point::new(t.cos(), t.sin()),
+        }
+    }
+
+    fn range(self) -> (f64, f64) {
+        match self {
+            Curve::Circle(_) => (0.0, TAU),
+            _ => (-4.0, 4.0),
+        }
+    }
+
+    /// Parameter of a point known to lie on the curve.
+    fn parameter(self, p: Point) -> f64 {
+        match self {
+            Curve::LineAB => p.y,
+            Curve::Horizontal(_) => p.x,
+            Curve::Circle(c) => (p.y - c).atan2(p.x).rem_euclid(TAU),
+        }
+    }
+
+    fn distance(self, p: Point) -> f64 {
+        match self {
+            Curve::LineAB => p.x.abs(),
+            Curve::Horizontal(c) => (p.y - c).abs(),
+            Curve::Circle(c) => (p.distance(Point::new(0.0, c)) - 1.0).abs(),
+        }
+    }
+}
+
+const A: Point = Point::new(0.0, 0.0);
+const B: Point = Point::new(0.0, 1.0);
+
+/// Points where some other boundary function changes sign along a curve.
+fn vertices() -> Vec<Point> {
+    let mut found: Vec<Point> = Vec::new();
+    let steps = 20_000;
+    for curve in Curve::ALL {
+        let (t0, t1) = curve.range();
+        let values = |t: f64| boundary_values(&A, &B, &curve.point(t));
+        let mut prev_t = t0;
+        let mut prev = values(t0);
+        for s in 1..=steps {
+            let t = t0 + (t1 - t0) * s as f64 / steps as f64;
+            let cur = values(t);
+            for k in 0..6 {
+                if (prev[k] < 0.0) != (cur[k] < 0.0) && (prev[k] != 0.0 || cur[k] != 0.0) {
+                    let (mut lo, mut hi) = (prev_t, t);
+                    for _ in 0..80 {
+                        let mid = 0.5 * (lo + hi);
+                        if (values(mid)[k] < 0.0) == (prev[k] < 0.0) {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    let p = curve.point(0.5 * (lo + hi));
+                    if !found.iter().any(|q| q.distance(p) < 1e-7) {
+                        found.push(p);
+                    }
+                }
+            }
+            prev_t = t;
+            prev = cur;
+        }
+    }
+    found
+}
+
+/// Regions whose closure contains `v`: those on either side of each curve through `v`, just
+/// beside it (a step far smaller than the cusps between tangent boundaries).
+fn regions_at(v: Point) -> RelationSet {
+    let mut set = RelationSet::EMPTY;
+    for curve in Curve::ALL {
+        if curve.distance(v) > 1e-9 {
+            continue;
+        }
+        let tv = curve.parameter(v);
+        for along in [-1e-4, 1e-4] {
+            let t = tv + along;
+            let p = curve.point(t);
+            let nrm = curve.normal(t);
+            for side in [-1e-12, 1e-12] {
+                if let Some(r) = classify(A, B, Point::new(p.x + side * nrm.x, p.y + side * nrm.y)) {
+                    set = set.with(r);
+                }
+            }
+        }
+    }
+    set
+}
+
+/// The adjacency relation: `result[r − 1]` is the set of regions adjacent to region `r`
+/// (irreflexive).
+pub fn adjacency() -> Vec<RelationSet> {
+    let mut adjacent = vec![RelationSet::EMPTY; 20];
+    for v in vertices() {
+        let around = regions_at(v);
+        for r in around.iter() {
+            adjacent[r as usize - 1] = adjacent[r as usize - 1].union(around.without(r));
+        }
+    }
+    adjacent
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn adjacency_is_symmetric_and_plausible() {
+        let adj = adjacency();
+        for r in 1..=20u8 {
+            for s in adj[r as usize - 1].iter() {
+                assert!(adj[s as usize - 1].contains(r), "{r} ~ {s} not symmetric");
+            }
+            assert!(!adj[r as usize - 1].contains(r));
+        }
+        // Left/right mirror pairs across AB: 1|2 share the line x = 0 above B.
+        assert!(adj[0].contains(2));
+        // The two lunes halves meet along y = ½ and across x = 0.
+        assert!(adj[6].contains(13) && adj[6].contains(8));
+        // Far-apart regions: front-left outside (1) and behind-right outside (20).
+        assert!(!adj[0].contains(20));
+        // The cusp of region 6 between circle A and y = 1 reaches B, where 4 also meets.
+        assert!(adj[5].contains(4));
+    }
+}

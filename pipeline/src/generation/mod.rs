@@ -1,0 +1,11 @@
+//! Offline generation of the operator tables committed under `tables/` (000 §III). The library
+//! never runs this at start-up; `tools/gen-tables` does, and the tests check that regenerating
+//! reproduces the committed files.
+
+mod edc_tables;
+mod fdc_tables;
+
+pub use edc_tables::{
+    edc_composition, edc_composition_cell, edc_unary, CompositionReport, EDC_SEARCH_HALF_WIDTH,
+};
+pub use fdc_tables::{fdc_composition, fdc_unary};

@@ -1,0 +1,10 @@
+//! qrm: qualitative relational mapping (McClelland, Campbell, Estlin; `../shared/seeds/000`).
+//!
+//! Stages live in one module each; see `docs/ARCHITECTURE.md`.
+
+pub mod calculus;
+pub mod edc;
+pub mod fdc;
+pub mod feasibility;
+pub mod generation;
+pub mod geometry;
