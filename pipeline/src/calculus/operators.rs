@@ -13,7 +13,11 @@ pub enum UnaryOperator {
 }
 
 impl UnaryOperator {
-    pub const ALL: [UnaryOperator; 3] = [UnaryOperator::Left, UnaryOperator::Right, UnaryOperator::Inverse];
+    pub const ALL: [UnaryOperator; 3] = [
+        UnaryOperator::Left,
+        UnaryOperator::Right,
+        UnaryOperator::Inverse,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {

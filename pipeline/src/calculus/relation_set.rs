@@ -128,7 +128,10 @@ impl FromStr for RelationSet {
         let inner = text.trim();
         let inner = inner
             .strip_prefix('{')
-            .map(|s| s.strip_suffix('}').ok_or_else(|| error("missing '}'".into())))
+            .map(|s| {
+                s.strip_suffix('}')
+                    .ok_or_else(|| error("missing '}'".into()))
+            })
             .transpose()?
             .unwrap_or(inner);
         let mut set = RelationSet::EMPTY;

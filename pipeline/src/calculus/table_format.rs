@@ -29,7 +29,9 @@ fn read_header(text: &str) -> Result<(String, u8), TableFormatError> {
     let mut calculus = None;
     let mut relations = None;
     for (i, line) in text.lines().enumerate() {
-        let Some(rest) = line.strip_prefix("# ") else { continue };
+        let Some(rest) = line.strip_prefix("# ") else {
+            continue;
+        };
         if let Some(name) = rest.strip_prefix("calculus ") {
             calculus = Some(name.trim().to_string());
         } else if let Some(n) = rest.strip_prefix("relations ") {
@@ -124,9 +126,21 @@ impl UnaryFile {
         for d in description {
             writeln!(s, "# {d}").unwrap();
         }
-        writeln!(s, "# columns: r  LEFT(AB:C=r)=BC:A  RIGHT(AB:C=r)=CA:B  INVERSE(AB:C=r)=BA:C").unwrap();
+        writeln!(
+            s,
+            "# columns: r  LEFT(AB:C=r)=BC:A  RIGHT(AB:C=r)=CA:B  INVERSE(AB:C=r)=BA:C"
+        )
+        .unwrap();
         for i in 0..self.relations as usize {
-            writeln!(s, "{} {} {} {}", i + 1, self.left[i], self.right[i], self.inverse[i]).unwrap();
+            writeln!(
+                s,
+                "{} {} {} {}",
+                i + 1,
+                self.left[i],
+                self.right[i],
+                self.inverse[i]
+            )
+            .unwrap();
         }
         s
     }
@@ -206,13 +220,27 @@ impl CompositionFile {
         for d in description {
             writeln!(s, "# {d}").unwrap();
         }
-        writeln!(s, "# rows: F ab_c bc_d ab_d <witness>   (possible, witness configuration)").unwrap();
-        writeln!(s, "#       U ab_c bc_d ab_d             (undecided, kept as possible)").unwrap();
+        writeln!(
+            s,
+            "# rows: F ab_c bc_d ab_d <witness>   (possible, witness configuration)"
+        )
+        .unwrap();
+        writeln!(
+            s,
+            "#       U ab_c bc_d ab_d             (undecided, kept as possible)"
+        )
+        .unwrap();
         for e in &self.entries {
             match e.kind {
-                EntryKind::Feasible => {
-                    writeln!(s, "F {} {} {} {}", e.ab_c, e.bc_d, e.ab_d, e.witness.join(" ")).unwrap()
-                }
+                EntryKind::Feasible => writeln!(
+                    s,
+                    "F {} {} {} {}",
+                    e.ab_c,
+                    e.bc_d,
+                    e.ab_d,
+                    e.witness.join(" ")
+                )
+                .unwrap(),
                 EntryKind::Undecided => writeln!(s, "U {} {} {}", e.ab_c, e.bc_d, e.ab_d).unwrap(),
             }
         }
@@ -220,7 +248,10 @@ impl CompositionFile {
     }
 
     pub fn undecided(&self) -> usize {
-        self.entries.iter().filter(|e| e.kind == EntryKind::Undecided).count()
+        self.entries
+            .iter()
+            .filter(|e| e.kind == EntryKind::Undecided)
+            .count()
     }
 }
 
@@ -234,8 +265,20 @@ mod tests {
             calculus: "X".into(),
             relations: 3,
             entries: vec![
-                CompositionEntry { kind: EntryKind::Feasible, ab_c: 1, bc_d: 1, ab_d: 2, witness: vec!["0.5".into(), "-1/3".into()] },
-                CompositionEntry { kind: EntryKind::Undecided, ab_c: 2, bc_d: 3, ab_d: 1, witness: vec![] },
+                CompositionEntry {
+                    kind: EntryKind::Feasible,
+                    ab_c: 1,
+                    bc_d: 1,
+                    ab_d: 2,
+                    witness: vec!["0.5".into(), "-1/3".into()],
+                },
+                CompositionEntry {
+                    kind: EntryKind::Undecided,
+                    ab_c: 2,
+                    bc_d: 3,
+                    ab_d: 1,
+                    witness: vec![],
+                },
             ],
         };
         let text = file.to_text(&["test"]);
@@ -257,6 +300,9 @@ mod tests {
         };
         assert_eq!(UnaryFile::parse(&file.to_text(&[])).unwrap(), file);
         assert!(UnaryFile::parse("# calculus X\n# relations 2\n1 {2} {1} {2}\n").is_err());
-        assert!(UnaryFile::parse("# calculus X\n# relations 2\n1 {3} {1} {2}\n2 {1} {1} {1}\n").is_err());
+        assert!(
+            UnaryFile::parse("# calculus X\n# relations 2\n1 {3} {1} {2}\n2 {1} {1} {1}\n")
+                .is_err()
+        );
     }
 }

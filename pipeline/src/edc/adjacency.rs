@@ -124,7 +124,8 @@ fn regions_at(v: Point) -> RelationSet {
             let p = curve.point(t);
             let nrm = curve.normal(t);
             for side in [-1e-12, 1e-12] {
-                if let Some(r) = classify(A, B, Point::new(p.x + side * nrm.x, p.y + side * nrm.y)) {
+                if let Some(r) = classify(A, B, Point::new(p.x + side * nrm.x, p.y + side * nrm.y))
+                {
                     set = set.with(r);
                 }
             }

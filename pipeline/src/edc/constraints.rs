@@ -50,16 +50,27 @@ mod tests {
         let a = fixed_point(2, 0.0, 0.0);
         let b = fixed_point(2, 0.0, 1.0);
         let c = free_point(2, 0, 1);
-        let all: Vec<Vec<Quadratic>> = (1..=20).map(|r| region_constraints(&a, &b, &c, r)).collect();
+        let all: Vec<Vec<Quadratic>> = (1..=20)
+            .map(|r| region_constraints(&a, &b, &c, r))
+            .collect();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         for _ in 0..20_000 {
             let x = [rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0)];
-            let Some(r) = classify(Point::new(0.0, 0.0), Point::new(0.0, 1.0), Point::new(x[0], x[1])) else {
+            let Some(r) = classify(
+                Point::new(0.0, 0.0),
+                Point::new(0.0, 1.0),
+                Point::new(x[0], x[1]),
+            ) else {
                 continue;
             };
             for (i, cs) in all.iter().enumerate() {
                 let inside = cs.iter().all(|q| q.eval(&x) < 0.0);
-                assert_eq!(inside, i + 1 == r as usize, "point {x:?} region {r} vs {}", i + 1);
+                assert_eq!(
+                    inside,
+                    i + 1 == r as usize,
+                    "point {x:?} region {r} vs {}",
+                    i + 1
+                );
             }
         }
     }

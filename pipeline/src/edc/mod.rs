@@ -6,7 +6,7 @@ mod region;
 
 pub use adjacency::adjacency;
 pub use constraints::{fixed_point, free_point, region_constraints};
-pub use region::{classify, defining_boundaries, region_of_signs, LUNE, REGIONS, SIGNS};
+pub use region::{classify, defining_boundaries, mirror, region_of_signs, LUNE, REGIONS, SIGNS};
 
 use crate::calculus::{Calculus, CompositionFile, OperatorTables, UnaryFile};
 use crate::geometry::Point;
@@ -34,8 +34,8 @@ impl Calculus for Edc {
             // The files are compiled in and checked by the test suite; failing here is a
             // build defect, not bad user input.
             let unary = UnaryFile::parse(UNARY_TABLE).expect("committed tables/edc_unary.txt");
-            let composition =
-                CompositionFile::parse(COMPOSITION_TABLE).expect("committed tables/edc_composition.txt");
+            let composition = CompositionFile::parse(COMPOSITION_TABLE)
+                .expect("committed tables/edc_composition.txt");
             OperatorTables::from_files(&unary, &composition)
         })
     }

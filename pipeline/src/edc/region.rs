@@ -22,26 +22,26 @@ pub const REGIONS: u8 = 20;
 /// Sign (+1 / −1) of each boundary function of [`Boundary::ALL`] inside each region `1..=20`:
 /// `[Left, FrontOfA, FrontOfB, NearerToB, OutsideCircleA, OutsideCircleB]`.
 pub const SIGNS: [[i8; 6]; 20] = [
-    [1, 1, 1, 1, 1, 1],        // 1
-    [-1, 1, 1, 1, 1, 1],       // 2
-    [1, 1, 1, 1, 1, -1],       // 3
-    [-1, 1, 1, 1, 1, -1],      // 4
-    [1, 1, -1, 1, 1, 1],       // 5
-    [1, 1, -1, 1, 1, -1],      // 6
-    [1, 1, -1, 1, -1, -1],     // 7
-    [-1, 1, -1, 1, -1, -1],    // 8
-    [-1, 1, -1, 1, 1, -1],     // 9
-    [-1, 1, -1, 1, 1, 1],      // 10
-    [1, 1, -1, -1, 1, 1],      // 11
-    [1, 1, -1, -1, -1, 1],     // 12
-    [1, 1, -1, -1, -1, -1],    // 13
-    [-1, 1, -1, -1, -1, -1],   // 14
-    [-1, 1, -1, -1, -1, 1],    // 15
-    [-1, 1, -1, -1, 1, 1],     // 16
-    [1, -1, -1, -1, -1, 1],    // 17
-    [-1, -1, -1, -1, -1, 1],   // 18
-    [1, -1, -1, -1, 1, 1],     // 19
-    [-1, -1, -1, -1, 1, 1],    // 20
+    [1, 1, 1, 1, 1, 1],      // 1
+    [-1, 1, 1, 1, 1, 1],     // 2
+    [1, 1, 1, 1, 1, -1],     // 3
+    [-1, 1, 1, 1, 1, -1],    // 4
+    [1, 1, -1, 1, 1, 1],     // 5
+    [1, 1, -1, 1, 1, -1],    // 6
+    [1, 1, -1, 1, -1, -1],   // 7
+    [-1, 1, -1, 1, -1, -1],  // 8
+    [-1, 1, -1, 1, 1, -1],   // 9
+    [-1, 1, -1, 1, 1, 1],    // 10
+    [1, 1, -1, -1, 1, 1],    // 11
+    [1, 1, -1, -1, -1, 1],   // 12
+    [1, 1, -1, -1, -1, -1],  // 13
+    [-1, 1, -1, -1, -1, -1], // 14
+    [-1, 1, -1, -1, -1, 1],  // 15
+    [-1, 1, -1, -1, 1, 1],   // 16
+    [1, -1, -1, -1, -1, 1],  // 17
+    [-1, -1, -1, -1, -1, 1], // 18
+    [1, -1, -1, -1, 1, 1],   // 19
+    [-1, -1, -1, -1, 1, 1],  // 20
 ];
 
 /// The lune of A and B (inside both circles): the regions that rule out an RNG edge (§VII-A).
@@ -50,6 +50,14 @@ pub const LUNE: [u8; 4] = [7, 8, 13, 14];
 /// The region whose sign vector is `signs`, if any.
 pub fn region_of_signs(signs: [i8; 6]) -> Option<u8> {
     SIGNS.iter().position(|s| *s == signs).map(|i| i as u8 + 1)
+}
+
+/// The region's mirror image across the line AB (left and right swapped): reflection maps a
+/// configuration with `AB:C = r` to one with `AB:C = mirror(r)` in every frame at once.
+pub fn mirror(region: u8) -> u8 {
+    let mut signs = SIGNS[region as usize - 1];
+    signs[0] = -signs[0];
+    region_of_signs(signs).expect("every region has a mirror image")
 }
 
 /// The EDC region of `c` relative to `a → b`, or `None` if `c` lies on a boundary (or the
@@ -85,7 +93,9 @@ pub fn defining_boundaries(region: u8) -> Vec<(Boundary, i8)> {
             kept = trial;
         }
     }
-    kept.into_iter().map(|k| (Boundary::ALL[k], own[k])).collect()
+    kept.into_iter()
+        .map(|k| (Boundary::ALL[k], own[k]))
+        .collect()
 }
 
 #[cfg(test)]
@@ -97,7 +107,12 @@ mod tests {
         for (i, s) in SIGNS.iter().enumerate() {
             assert_eq!(region_of_signs(*s), Some(i as u8 + 1));
             let d = defining_boundaries(i as u8 + 1);
-            assert!((2..=4).contains(&d.len()), "region {} uses {}", i + 1, d.len());
+            assert!(
+                (2..=4).contains(&d.len()),
+                "region {} uses {}",
+                i + 1,
+                d.len()
+            );
         }
     }
 
@@ -107,7 +122,11 @@ mod tests {
         let d = defining_boundaries(2);
         assert_eq!(
             d,
-            vec![(Boundary::Left, -1), (Boundary::FrontOfB, 1), (Boundary::OutsideCircleB, 1)]
+            vec![
+                (Boundary::Left, -1),
+                (Boundary::FrontOfB, 1),
+                (Boundary::OutsideCircleB, 1)
+            ]
         );
         let a = Point::new(0.0, 0.0);
         let b = Point::new(0.0, 1.0);

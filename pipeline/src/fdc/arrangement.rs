@@ -127,7 +127,10 @@ pub fn faces_of_fourth_point(a: &Point2<Q>, b: &Point2<Q>, c: &Point2<Q>) -> Vec
                 }
             }
             for s in [eps.clone(), -eps] {
-                push_unique(&mut faces, Point2::new(&e.x + &s * &normal.0, &e.y + &s * &normal.1));
+                push_unique(
+                    &mut faces,
+                    Point2::new(&e.x + &s * &normal.0, &e.y + &s * &normal.1),
+                );
             }
             push_unique(&mut faces, e);
         }
@@ -153,7 +156,16 @@ pub fn candidate_third_points() -> Vec<Point2<Q>> {
         }
     }
     // x = t/(1+t²), y = 1/(1+t²) lies on x² + y² = y.
-    for (n, d) in [(1, 2), (2, 1), (1, 3), (3, 1), (2, 3), (3, 2), (1, 4), (4, 1)] {
+    for (n, d) in [
+        (1, 2),
+        (2, 1),
+        (1, 3),
+        (3, 1),
+        (2, 3),
+        (3, 2),
+        (1, 4),
+        (4, 1),
+    ] {
         for sign in [1, -1] {
             let t = q(sign * n, d);
             let den = Q::from_integer(1.into()) + &t * &t;
@@ -185,7 +197,12 @@ mod tests {
         }
         let relations: std::collections::BTreeSet<(u8, u8)> = faces
             .iter()
-            .map(|d| (classify_exact(&b, &c, d).unwrap(), classify_exact(&a, &b, d).unwrap()))
+            .map(|d| {
+                (
+                    classify_exact(&b, &c, d).unwrap(),
+                    classify_exact(&a, &b, d).unwrap(),
+                )
+            })
             .collect();
         // Every BC:D relation occurs (D ranges over the whole plane).
         for r in 1..=15 {

@@ -83,8 +83,8 @@ impl Calculus for Fdc {
         static TABLES: OnceLock<OperatorTables> = OnceLock::new();
         TABLES.get_or_init(|| {
             let unary = UnaryFile::parse(UNARY_TABLE).expect("committed tables/fdc_unary.txt");
-            let composition =
-                CompositionFile::parse(COMPOSITION_TABLE).expect("committed tables/fdc_composition.txt");
+            let composition = CompositionFile::parse(COMPOSITION_TABLE)
+                .expect("committed tables/fdc_composition.txt");
             OperatorTables::from_files(&unary, &composition)
         })
     }
@@ -99,11 +99,21 @@ mod tests {
         let a = Point::new(0.0, 0.0);
         let b = Point::new(0.0, 1.0);
         let cases = [
-            ((-1.0, 2.0), 1), ((0.0, 2.0), 2), ((1.0, 2.0), 3),
-            ((-1.0, 1.0), 4), ((0.0, 1.0), 5), ((1.0, 1.0), 6),
-            ((-1.0, 0.5), 7), ((0.0, 0.5), 8), ((1.0, 0.5), 9),
-            ((-1.0, 0.0), 10), ((0.0, 0.0), 11), ((1.0, 0.0), 12),
-            ((-1.0, -1.0), 13), ((0.0, -1.0), 14), ((1.0, -1.0), 15),
+            ((-1.0, 2.0), 1),
+            ((0.0, 2.0), 2),
+            ((1.0, 2.0), 3),
+            ((-1.0, 1.0), 4),
+            ((0.0, 1.0), 5),
+            ((1.0, 1.0), 6),
+            ((-1.0, 0.5), 7),
+            ((0.0, 0.5), 8),
+            ((1.0, 0.5), 9),
+            ((-1.0, 0.0), 10),
+            ((0.0, 0.0), 11),
+            ((1.0, 0.0), 12),
+            ((-1.0, -1.0), 13),
+            ((0.0, -1.0), 14),
+            ((1.0, -1.0), 15),
         ];
         for ((x, y), r) in cases {
             assert_eq!(Fdc::classify(a, b, Point::new(x, y)), Some(r), "({x},{y})");

@@ -25,9 +25,6 @@ pub struct Settings {
     /// A box is refuted when every point of it misses some constraint `q_j` by less than
     /// `margin × scale(q_j)`: feasible sets thinner than that are treated as empty.
     pub margin: f64,
-    /// Margin (in units of a constraint's spread over the box) below which the joint
-    /// relaxation refutes a box; set just above the LP solver's accuracy.
-    pub relaxation_margin: f64,
     /// Use the joint relaxation at all.
     pub use_relaxation: bool,
     /// Use interval propagation.
@@ -42,8 +39,7 @@ impl Default for Settings {
             seed: 0x9E37_79B9_7F4A_7C15,
             max_boxes: 200_000,
             min_relative_width: 1e-9,
-            margin: 1e-12,
-            relaxation_margin: 1e-7,
+            margin: 1e-9,
             use_relaxation: true,
             use_propagation: true,
             samples_per_box: 2,
@@ -96,7 +92,9 @@ impl BranchAndBound {
         let mut unresolved: u64 = 0; // alternatives left open in boxes that may not be split
         let all: u64 = if k == 64 { u64::MAX } else { (1u64 << k) - 1 };
         let mut pending = all; // alternatives without a witness yet
-        let widths: Vec<f64> = (0..n).map(|i| problem.upper[i] - problem.lower[i]).collect();
+        let widths: Vec<f64> = (0..n)
+            .map(|i| problem.upper[i] - problem.lower[i])
+            .collect();
         let mut stack = vec![Cell {
             lo: problem.lower.clone(),
             hi: problem.upper.clone(),
@@ -126,6 +124,7 @@ impl BranchAndBound {
                     stats.propagation_refutations += 1;
                     continue;
                 }
+                snap_outward(&mut cell, problem);
             }
             if refuted(problem.common.iter(), &cell, s.margin) {
                 continue;
@@ -140,7 +139,13 @@ impl BranchAndBound {
                         rng.random_range(cell.lo[i]..=cell.hi[i])
                     };
                 }
-                record_witnesses(problem, &candidate, &mut cell.open, &mut pending, &mut witnesses);
+                record_witnesses(
+                    problem,
+                    &candidate,
+                    &mut cell.open,
+                    &mut pending,
+                    &mut witnesses,
+                );
             }
 
             // Per-constraint exact minima, then the joint relaxation.
@@ -155,11 +160,10 @@ impl BranchAndBound {
                     continue;
                 }
                 if s.use_relaxation {
-                    let joint: Vec<&Quadratic> =
-                        problem.common.iter().chain(alternative).collect();
+                    let joint: Vec<&Quadratic> = problem.common.iter().chain(alternative).collect();
                     stats.relaxations += 1;
                     if let Some(bound) = joint_relaxation(&joint, &cell.lo, &cell.hi) {
-                        if bound.margin <= s.relaxation_margin {
+                        if bound.margin <= s.margin {
                             stats.relaxation_refutations += 1;
                             cell.open &= !bit;
                             continue;
@@ -181,14 +185,23 @@ impl BranchAndBound {
 
             // Split the relatively widest unknown at its midpoint.
             let (axis, rel) = (0..n)
-                .map(|i| (i, (cell.hi[i] - cell.lo[i]) / widths[i].max(f64::MIN_POSITIVE)))
+                .map(|i| {
+                    (
+                        i,
+                        (cell.hi[i] - cell.lo[i]) / widths[i].max(f64::MIN_POSITIVE),
+                    )
+                })
                 .max_by(|a, b| a.1.total_cmp(&b.1))
                 .expect("at least one unknown");
             if rel < s.min_relative_width {
                 unresolved |= cell.open;
                 continue;
             }
-            let mid = 0.5 * (cell.lo[axis] + cell.hi[axis]);
+            let mid = split_point(
+                cell.lo[axis],
+                cell.hi[axis],
+                problem.upper[axis] - problem.lower[axis],
+            );
             let mut upper = Cell {
                 lo: cell.lo.clone(),
                 hi: cell.hi.clone(),
@@ -211,8 +224,63 @@ impl BranchAndBound {
     }
 }
 
+/// The simplest dyadic value (fewest bits on the grid of the initial box) in the middle 80 % of
+/// `[lo, hi]`, nearest the midpoint. A box straddling 0, 1 or ½ — values where EDC boundaries
+/// of different frames meet — is cut exactly there, so both halves can be refuted by sign.
+fn split_point(lo: f64, hi: f64, total: f64) -> f64 {
+    let mid = 0.5 * (lo + hi);
+    let (a, b) = (lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo));
+    let mut step = total;
+    while step > (hi - lo) * 1e-3 {
+        let k = (mid / step).round() * step;
+        let candidates = [k, k - step, k + step];
+        if let Some(v) = candidates
+            .into_iter()
+            .filter(|v| *v >= a && *v <= b)
+            .min_by(|x, y| (x - mid).abs().total_cmp(&(y - mid).abs()))
+        {
+            return v;
+        }
+        step *= 0.5;
+    }
+    mid
+}
+
+/// Rounds a contracted box outward to a dyadic grid of the initial box (spacing about 1/64 of
+/// the box's width). Midpoint splits then keep landing on simple values such as 0, 1 and ½,
+/// which are where EDC boundaries meet: boxes that end exactly on a shared boundary can be
+/// refuted by exact bounds instead of straddling it forever.
+fn snap_outward(cell: &mut Cell, problem: &Problem) {
+    for i in 0..cell.lo.len() {
+        let total = problem.upper[i] - problem.lower[i];
+        let w = cell.hi[i] - cell.lo[i];
+        if w <= 0.0 || total <= 0.0 {
+            continue;
+        }
+        let step = total * 2f64.powi((w / total / 64.0).log2().floor() as i32);
+        if step > 0.0 && step.is_finite() {
+            // Propagation pads its bounds by a few ulps for safety; a bound within that pad of a
+            // grid point snaps to it rather than a whole step outward.
+            let snap = |v: f64, outward: fn(f64) -> f64| {
+                let k = (v / step).round();
+                if (v - k * step).abs() <= 1e-11 * (1.0 + v.abs()) {
+                    k * step
+                } else {
+                    outward(v / step) * step
+                }
+            };
+            cell.lo[i] = snap(cell.lo[i], f64::floor).max(problem.lower[i]);
+            cell.hi[i] = snap(cell.hi[i], f64::ceil).min(problem.upper[i]);
+        }
+    }
+}
+
 /// Whether some constraint stays at or above `−margin·scale` on the whole box.
-fn refuted<'a>(mut constraints: impl Iterator<Item = &'a Quadratic>, cell: &Cell, margin: f64) -> bool {
+fn refuted<'a>(
+    mut constraints: impl Iterator<Item = &'a Quadratic>,
+    cell: &Cell,
+    margin: f64,
+) -> bool {
     constraints.any(|q| minimum_over_box(q, &cell.lo, &cell.hi) >= -margin * q.scale())
 }
 

@@ -51,7 +51,11 @@ fn solve_quadratic_le(a: f64, b: f64, c: f64, lo: f64, hi: f64) -> Option<(f64, 
     let sq = disc.sqrt();
     // Numerically stable roots.
     let qv = -0.5 * (b + b.signum() * sq);
-    let (mut r1, mut r2) = if qv != 0.0 { (qv / a, c / qv) } else { (0.0, 0.0) };
+    let (mut r1, mut r2) = if qv != 0.0 {
+        (qv / a, c / qv)
+    } else {
+        (0.0, 0.0)
+    };
     if r1 > r2 {
         std::mem::swap(&mut r1, &mut r2);
     }
@@ -81,15 +85,20 @@ fn product_range(a: f64, lo1: f64, hi1: f64, lo2: f64, hi2: f64) -> (f64, f64) {
 
 fn square_min(a: f64, lo: f64, hi: f64) -> f64 {
     if a >= 0.0 {
-        let m = if lo <= 0.0 && hi >= 0.0 { 0.0 } else { lo.abs().min(hi.abs()) };
+        let m = if lo <= 0.0 && hi >= 0.0 {
+            0.0
+        } else {
+            lo.abs().min(hi.abs())
+        };
         a * m * m
     } else {
         a * lo.abs().max(hi.abs()).powi(2)
     }
 }
 
-/// Shrinks `[lo, hi]` in place under every `q < margin` (a small positive `margin` keeps
-/// rounding on the safe side). Returns false when the box is proved empty.
+/// Shrinks `[lo, hi]` in place to the hull of the points where every constraint can still hold
+/// with the search's margin, `q ≤ −margin·scale(q)` (see `Settings::margin`); bounds are padded
+/// by a few ulps against rounding. Returns false when the box is proved empty.
 pub fn contract(constraints: &[&Quadratic], lo: &mut [f64], hi: &mut [f64], margin: f64) -> bool {
     let n = lo.len();
     for _round in 0..3 {
@@ -101,7 +110,7 @@ pub fn contract(constraints: &[&Quadratic], lo: &mut [f64], hi: &mut [f64], marg
                 }
                 // q = a x_i² + p x_i + rest, p = b_i + 2 Σ_{j≠i} a_ij x_j.
                 let (mut p_lo, mut p_hi) = (q.b[i], q.b[i]);
-                let mut rest = q.c - margin.abs() * q.scale().max(1e-300);
+                let mut rest = q.c + margin.abs() * q.scale();
                 for j in 0..n {
                     if j == i {
                         continue;

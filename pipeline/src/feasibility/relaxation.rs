@@ -10,13 +10,16 @@
 //! The box is first mapped to `[−1, 1]ⁿ` (centre and half-widths) so that the LP is well
 //! conditioned however small the box has become.
 
-use super::quadratic::Quadratic;
+use super::quadratic::{Linear, Quadratic, Shape};
+use crate::geometry::Coordinate;
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
 
 /// Result of the joint relaxation on one box.
 pub struct RelaxationBound {
-    /// Largest margin of the relaxation, in units of each constraint's spread over the box.
+    /// Largest margin of the relaxation, in units of each constraint's coefficient scale.
     pub margin: f64,
     /// The relaxation's optimal point in the original unknowns: a good witness candidate.
     pub point: Vec<f64>,
@@ -50,11 +53,36 @@ pub fn joint_relaxation(
     let h: Vec<f64> = lo.iter().zip(hi).map(|(l, u)| 0.5 * (u - l)).collect();
     let normalised: Vec<Quadratic> = constraints.iter().map(|q| normalise(q, &m, &h)).collect();
 
+    // Valid inequalities `p ≤ 0` from products of the linear constraints (ℓ < 0) with each
+    // other (ℓ_i ℓ_j ≥ 0) and with the bound factors (ℓ (1 ± u_k) ≤ 0): they let the LP use
+    // sign reasoning such as "C left of AB and D below B, so their cross term is positive",
+    // which refutes boxes straddling boundaries shared by two frames.
+    let linear: Vec<Linear> = normalised
+        .iter()
+        .filter(|q| q.shape() == Shape::Linear)
+        .map(|q| Linear {
+            b: q.b.clone(),
+            c: q.c,
+        })
+        .collect();
+    let mut products: Vec<Quadratic> = Vec::new();
+    for (i, li) in linear.iter().enumerate() {
+        for lj in &linear[i + 1..] {
+            products.push(-li.mul(lj));
+        }
+        for k in 0..n {
+            let uk = Linear::variable(n, k);
+            let one = Linear::constant(n, 1.0);
+            products.push(li.mul(&(one.clone() - uk.clone())));
+            products.push(li.mul(&(one + uk)));
+        }
+    }
+
     // Lifted variables only for the products that occur.
     let mut pairs: Vec<(usize, usize)> = Vec::new();
     for k in 0..n {
         for l in k..n {
-            if normalised.iter().any(|q| q.a(k, l) != 0.0) {
+            if normalised.iter().chain(&products).any(|q| q.a(k, l) != 0.0) {
                 pairs.push((k, l));
             }
         }
@@ -63,20 +91,27 @@ pub fn joint_relaxation(
     let t = nv - 1;
     let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
     let mut rhs: Vec<f64> = Vec::new();
-
-    for q in &normalised {
-        // Spread of the constraint over the box: the unit of the margin.
-        let spread = q.b.iter().map(|v| v.abs()).sum::<f64>()
-            + q.a.iter().map(|v| v.abs()).sum::<f64>();
-        let spread = if spread > 0.0 { spread } else { 1.0 };
+    let linearise = |q: &Quadratic| -> Vec<(usize, f64)> {
         let mut row: Vec<(usize, f64)> = (0..n).map(|i| (i, q.b[i])).collect();
         for (p, &(k, l)) in pairs.iter().enumerate() {
             let coef = if k == l { q.a(k, k) } else { 2.0 * q.a(k, l) };
             row.push((n + p, coef));
         }
-        row.push((t, spread));
+        row
+    };
+
+    for (q, original) in normalised.iter().zip(constraints) {
+        // The margin is measured in units of each constraint's coefficient scale, as in the
+        // per-constraint bounds, so one threshold means the same for both.
+        let scale = original.scale().max(f64::MIN_POSITIVE);
+        let mut row = linearise(q);
+        row.push((t, scale));
         rows.push(row);
         rhs.push(-q.c);
+    }
+    for p in &products {
+        rows.push(linearise(p));
+        rhs.push(-p.c);
     }
     // RLT bound-factor products on [−1, 1]: (1 ± u_k)(1 ± u_l) ≥ 0.
     for (p, &(k, l)) in pairs.iter().enumerate() {
@@ -131,7 +166,9 @@ pub fn joint_relaxation(
         _ => return None,
     }
     let x = &solver.solution.x;
-    let point = (0..n).map(|i| m[i] + h[i] * x[i].clamp(-1.0, 1.0)).collect();
+    let point = (0..n)
+        .map(|i| m[i] + h[i] * x[i].clamp(-1.0, 1.0))
+        .collect();
     Some(RelaxationBound {
         margin: x[t],
         point,
@@ -164,7 +201,6 @@ fn csc_from_rows(rows: &[Vec<(usize, f64)>], ncols: usize) -> CscMatrix<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::feasibility::quadratic::Linear;
 
     #[test]
     fn opposite_constraints_have_no_margin() {

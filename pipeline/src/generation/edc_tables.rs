@@ -7,9 +7,9 @@
 //! then proves the rest impossible or finds their witnesses.
 
 use crate::calculus::{CompositionEntry, CompositionFile, EntryKind, RelationSet, UnaryFile};
-use crate::edc::{classify, fixed_point, free_point, region_constraints, REGIONS};
-use crate::feasibility::{BranchAndBound, Outcome, Problem, Settings};
-use crate::geometry::Point;
+use crate::edc::{classify, fixed_point, free_point, mirror, region_constraints, REGIONS, SIGNS};
+use crate::feasibility::{BranchAndBound, Linear, Outcome, Problem, Settings};
+use crate::geometry::{Point, Point2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -22,7 +22,10 @@ pub const EDC_SEARCH_HALF_WIDTH: f64 = 8.0;
 const SAMPLES_PER_CELL: usize = 3000;
 
 fn search_box(n: usize) -> (Vec<f64>, Vec<f64>) {
-    (vec![-EDC_SEARCH_HALF_WIDTH; n], vec![EDC_SEARCH_HALF_WIDTH; n])
+    (
+        vec![-EDC_SEARCH_HALF_WIDTH; n],
+        vec![EDC_SEARCH_HALF_WIDTH; n],
+    )
 }
 
 /// A random point of `region` in the frame A=(0,0), B=(0,1), at a random scale.
@@ -39,6 +42,15 @@ fn sample_region(rng: &mut ChaCha8Rng, region: u8) -> Point {
             return p;
         }
     }
+}
+
+/// Whether `x = (C, D)` realises the triple `(AB:C, BC:D, AB:D)` by direct classification.
+fn witness_classifies(x: &[f64], ab_c: u8, bc_d: u8, ab_d: u8) -> bool {
+    let (a, b) = (Point::new(0.0, 0.0), Point::new(0.0, 1.0));
+    let (c, d) = (Point::new(x[0], x[1]), Point::new(x[2], x[3]));
+    classify(a, b, c) == Some(ab_c)
+        && classify(b, c, d) == Some(bc_d)
+        && classify(a, b, d) == Some(ab_d)
 }
 
 /// Shortest decimal rendering (4, 6 or 9 decimals, else full precision) that still satisfies.
@@ -71,10 +83,57 @@ pub struct CompositionReport {
     pub proved_infeasible: usize,
     pub undecided: usize,
     pub boxes: usize,
+    /// Wall time of each searched cell, slowest first (full-table runs only).
+    pub slowest_cells: Vec<((u8, u8), f64)>,
 }
 
-/// Decides one cell: every `AB:D` compatible with `AB:C = ab_c`, `BC:D = bc_d`.
-pub fn edc_composition_cell(ab_c: u8, bc_d: u8, settings: &Settings) -> (Vec<CompositionEntry>, CompositionReport) {
+/// Decides one cell: every `AB:D` compatible with `AB:C = ab_c`, `BC:D = bc_d`. Cells with C
+/// right of AB are the mirror images of cells with C left of it (reflection across AB swaps
+/// left and right in every frame), so only the left half is searched.
+pub fn edc_composition_cell(
+    ab_c: u8,
+    bc_d: u8,
+    settings: &Settings,
+) -> (Vec<CompositionEntry>, CompositionReport) {
+    if SIGNS[ab_c as usize - 1][0] > 0 {
+        return search_cell(ab_c, bc_d, settings);
+    }
+    let (entries, report) = search_cell(mirror(ab_c), mirror(bc_d), settings);
+    (mirror_cell(ab_c, bc_d, entries), report)
+}
+
+/// The entries of cell `(ab_c, bc_d)` from those of its mirror image: regions mirrored,
+/// witnesses reflected (x ↦ −x).
+fn mirror_cell(ab_c: u8, bc_d: u8, entries: Vec<CompositionEntry>) -> Vec<CompositionEntry> {
+    let negate = |v: &String| match v.strip_prefix('-') {
+        Some(positive) => positive.to_string(),
+        None if v.parse::<f64>() == Ok(0.0) => v.clone(),
+        None => format!("-{v}"),
+    };
+    let mut mirrored: Vec<CompositionEntry> = entries
+        .into_iter()
+        .map(|e| CompositionEntry {
+            kind: e.kind,
+            ab_c,
+            bc_d,
+            ab_d: mirror(e.ab_d),
+            witness: e
+                .witness
+                .iter()
+                .enumerate()
+                .map(|(i, v)| if i % 2 == 0 { negate(v) } else { v.clone() })
+                .collect(),
+        })
+        .collect();
+    mirrored.sort_by_key(|e| e.ab_d);
+    mirrored
+}
+
+fn search_cell(
+    ab_c: u8,
+    bc_d: u8,
+    settings: &Settings,
+) -> (Vec<CompositionEntry>, CompositionReport) {
     let n = 4;
     let a = fixed_point(n, 0.0, 0.0);
     let b = fixed_point(n, 0.0, 1.0);
@@ -87,7 +146,9 @@ pub fn edc_composition_cell(ab_c: u8, bc_d: u8, settings: &Settings) -> (Vec<Com
         lower,
         upper,
         common,
-        alternatives: (1..=REGIONS).map(|r| region_constraints(&a, &b, &d, r)).collect(),
+        alternatives: (1..=REGIONS)
+            .map(|r| region_constraints(&a, &b, &d, r))
+            .collect(),
     };
     let mut report = CompositionReport::default();
     let mut witnesses: Vec<Option<Vec<String>>> = vec![None; REGIONS as usize];
@@ -101,40 +162,89 @@ pub fn edc_composition_cell(ab_c: u8, bc_d: u8, settings: &Settings) -> (Vec<Com
         let dx = pd.x * v.y + pd.y * v.x;
         let dy = 1.0 - pd.x * v.x + pd.y * v.y;
         let x = [pc.x, pc.y, dx, dy];
-        let Some(r3) = classify(Point::new(0.0, 0.0), Point::new(0.0, 1.0), Point::new(dx, dy)) else {
+        let Some(r3) = classify(
+            Point::new(0.0, 0.0),
+            Point::new(0.0, 1.0),
+            Point::new(dx, dy),
+        ) else {
             continue;
         };
         let k = r3 as usize - 1;
-        if witnesses[k].is_none() && full.satisfies(k, &x) {
-            witnesses[k] = Some(tidy_witness(&x, |w| full.satisfies(k, w)));
+        if witnesses[k].is_none() && witness_classifies(&x, ab_c, bc_d, r3) {
+            witnesses[k] = Some(tidy_witness(&x, |w| witness_classifies(w, ab_c, bc_d, r3)));
             report.sampled += 1;
         }
     }
 
-    // Branch and bound on the rest.
-    let rest: Vec<usize> = (0..REGIONS as usize).filter(|&k| witnesses[k].is_none()).collect();
+    // Branch and bound on the rest, one candidate at a time, alternating two parametrisations
+    // of D with growing budgets. The boundaries of the two frames touch either at D = B, a fixed
+    // point when D itself is the unknown, or at D = C, a fixed point (W = 0) when W = D − C is.
+    // Boxes that end exactly on a touching point are refuted at once instead of shrinking
+    // towards it forever; each problem is easy in one of the two.
+    let small = Settings {
+        max_boxes: settings.max_boxes / 50,
+        ..settings.clone()
+    };
+    let passes = [
+        (false, &small),
+        (true, &small),
+        (false, settings),
+        (true, settings),
+    ];
     let mut undecided = vec![false; REGIONS as usize];
-    if !rest.is_empty() {
-        let problem = Problem {
-            lower: full.lower.clone(),
-            upper: full.upper.clone(),
-            common: full.common.clone(),
-            alternatives: rest.iter().map(|&k| full.alternatives[k].clone()).collect(),
-        };
-        let (outcomes, stats) = BranchAndBound::new(settings.clone()).solve(&problem);
-        report.boxes += stats.boxes;
-        for (&k, outcome) in rest.iter().zip(outcomes) {
-            match outcome {
+    let open: Vec<usize> = (0..REGIONS as usize)
+        .filter(|&k| witnesses[k].is_none())
+        .collect();
+    for k in open {
+        let r3 = k as u8 + 1;
+        let mut decided = false;
+        for (relative_to_c, pass_settings) in passes {
+            let d = if relative_to_c {
+                Point2::new(
+                    c.x.clone() + Linear::variable(n, 2),
+                    c.y.clone() + Linear::variable(n, 3),
+                )
+            } else {
+                free_point(n, 2, 3)
+            };
+            let reach = if relative_to_c { 2.0 } else { 1.0 } * EDC_SEARCH_HALF_WIDTH;
+            let mut lower = full.lower.clone();
+            let mut upper = full.upper.clone();
+            lower[2..].fill(-reach);
+            upper[2..].fill(reach);
+            let mut constraints = region_constraints(&a, &b, &c, ab_c);
+            constraints.extend(region_constraints(&b, &c, &d, bc_d));
+            constraints.extend(region_constraints(&a, &b, &d, r3));
+            let problem = Problem::single(lower, upper, constraints);
+            let (mut outcomes, stats) = BranchAndBound::new(pass_settings.clone()).solve(&problem);
+            report.boxes += stats.boxes;
+            match outcomes.remove(0) {
                 Outcome::Feasible(x) => {
-                    witnesses[k] = Some(tidy_witness(&x, |w| full.satisfies(k, w)));
-                    report.searched_feasible += 1;
+                    // Back to (C, D) coordinates for the table.
+                    let x = if relative_to_c {
+                        vec![x[0], x[1], x[0] + x[2], x[1] + x[3]]
+                    } else {
+                        x
+                    };
+                    if witness_classifies(&x, ab_c, bc_d, r3) {
+                        witnesses[k] =
+                            Some(tidy_witness(&x, |w| witness_classifies(w, ab_c, bc_d, r3)));
+                        report.searched_feasible += 1;
+                        decided = true;
+                        break;
+                    }
                 }
-                Outcome::Infeasible => report.proved_infeasible += 1,
-                Outcome::Undecided => {
-                    undecided[k] = true;
-                    report.undecided += 1;
+                Outcome::Infeasible => {
+                    report.proved_infeasible += 1;
+                    decided = true;
+                    break;
                 }
+                Outcome::Undecided => {}
             }
+        }
+        if !decided {
+            undecided[k] = true;
+            report.undecided += 1;
         }
     }
     let entries = (0..REGIONS as usize)
@@ -151,27 +261,45 @@ pub fn edc_composition_cell(ab_c: u8, bc_d: u8, settings: &Settings) -> (Vec<Com
 }
 
 /// The full EDC composition table; `progress` is called once per finished cell.
-pub fn edc_composition(settings: &Settings, progress: impl Fn() + Sync) -> (CompositionFile, CompositionReport) {
-    let cells: Vec<(u8, u8)> = (1..=REGIONS)
+pub fn edc_composition(
+    settings: &Settings,
+    progress: impl Fn() + Sync,
+) -> (CompositionFile, CompositionReport) {
+    // Search the left half in parallel, then fill every cell (mirroring the right half).
+    let left: Vec<(u8, u8)> = (1..=REGIONS)
+        .filter(|&r1| SIGNS[r1 as usize - 1][0] > 0)
         .flat_map(|r1| (1..=REGIONS).map(move |r2| (r1, r2)))
         .collect();
-    let results: Vec<(Vec<CompositionEntry>, CompositionReport)> = cells
+    let searched: Vec<((u8, u8), (Vec<CompositionEntry>, CompositionReport), f64)> = left
         .par_iter()
-        .map(|&(r1, r2)| {
-            let out = edc_composition_cell(r1, r2, settings);
+        .map(|&cell| {
+            let start = std::time::Instant::now();
+            let out = search_cell(cell.0, cell.1, settings);
             progress();
-            out
+            (cell, out, start.elapsed().as_secs_f64())
         })
         .collect();
     let mut total = CompositionReport::default();
     let mut entries = Vec::new();
-    for (e, r) in results {
-        entries.extend(e);
+    let mut by_cell = std::collections::HashMap::new();
+    for (cell, (e, r), seconds) in searched {
+        total.slowest_cells.push((cell, seconds));
         total.sampled += r.sampled;
         total.searched_feasible += r.searched_feasible;
         total.proved_infeasible += r.proved_infeasible;
         total.undecided += r.undecided;
         total.boxes += r.boxes;
+        by_cell.insert(cell, e);
+    }
+    total.slowest_cells.sort_by(|a, b| b.1.total_cmp(&a.1));
+    for r1 in 1..=REGIONS {
+        for r2 in 1..=REGIONS {
+            let e = match by_cell.get(&(r1, r2)) {
+                Some(e) => e.clone(),
+                None => mirror_cell(r1, r2, by_cell[&(mirror(r1), mirror(r2))].clone()),
+            };
+            entries.extend(e);
+        }
     }
     (
         CompositionFile {
@@ -218,10 +346,12 @@ pub fn edc_unary(settings: &Settings) -> (UnaryFile, usize) {
         inverse: Vec::new(),
     };
     for r in 1..=REGIONS {
-        file.left.push(solve_for(r, &|s| region_constraints(&b, &c, &a, s)));
-        file.right.push(solve_for(r, &|s| region_constraints(&c, &a, &b, s)));
-        file.inverse.push(solve_for(r, &|s| region_constraints(&b, &a, &c, s)));
+        file.left
+            .push(solve_for(r, &|s| region_constraints(&b, &c, &a, s)));
+        file.right
+            .push(solve_for(r, &|s| region_constraints(&c, &a, &b, s)));
+        file.inverse
+            .push(solve_for(r, &|s| region_constraints(&b, &a, &c, s)));
     }
     (file, undecided)
 }
-

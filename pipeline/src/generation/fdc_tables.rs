@@ -11,7 +11,10 @@ use std::collections::BTreeMap;
 fn frame() -> (Point2<BigRational>, Point2<BigRational>) {
     let zero = BigRational::from_integer(BigInt::from(0));
     let one = BigRational::from_integer(BigInt::from(1));
-    (Point2::new(zero.clone(), zero.clone()), Point2::new(zero, one))
+    (
+        Point2::new(zero.clone(), zero.clone()),
+        Point2::new(zero, one),
+    )
 }
 
 /// LEFT, RIGHT and INVERSE over all candidate positions of C. With C = B or C = A some frames
@@ -54,7 +57,10 @@ pub fn fdc_composition() -> CompositionFile {
                 .filter_map(|d| {
                     let r2 = classify_exact(&b, c, &d)?;
                     let r3 = classify_exact(&a, &b, &d)?;
-                    let w = [&c.x, &c.y, &d.x, &d.y].iter().map(|v| v.to_string()).collect();
+                    let w = [&c.x, &c.y, &d.x, &d.y]
+                        .iter()
+                        .map(|v| v.to_string())
+                        .collect();
                     Some(((r1, r2, r3), w))
                 })
                 .collect()
