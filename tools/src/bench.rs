@@ -1,47 +1,97 @@
-//! Benchmarks of the calculus core (figures for docs/BENCHMARKS.md): feasibility decisions in
-//! 2 and 4 unknowns and one composition cell.
+//! Benchmarks of the calculus core (figures in docs/BENCHMARKS.md):
+//! - median time of one 2-unknown feasibility decision (all 3 × 20 × 20 EDC unary problems),
+//! - median time of one 4-unknown decision (a deterministic sample of composition triples),
+//! - wall time to regenerate each table.
 
 use clap::Parser;
-use qrm::feasibility::Settings;
-use qrm::generation::edc_composition_cell;
+use qrm::edc::{fixed_point, free_point, region_constraints};
+use qrm::feasibility::{BranchAndBound, Outcome, Quadratic};
+use qrm::generation::{edc_composition, edc_unary, fdc_composition, fdc_unary};
 use std::time::Instant;
 
 #[derive(Parser, Debug)]
+#[command(about = "Time feasibility decisions and table generation")]
 struct Args {
-    /// Time single composition cells `r1,r2`.
-    #[arg(long, value_delimiter = ',', num_args = 2)]
-    cell: Vec<u8>,
+    /// Skip regenerating the full EDC composition table (the slow part).
+    #[arg(long)]
+    quick: bool,
+}
+
+/// Median and 90th percentile in microseconds, with the outcome counts.
+fn time_decisions(problems: &[(Vec<f64>, Vec<f64>, Vec<Quadratic>)]) -> (f64, f64, [usize; 3]) {
+    let engine = BranchAndBound::default();
+    let mut times = Vec::with_capacity(problems.len());
+    let mut counts = [0usize; 3];
+    for (lo, hi, cs) in problems {
+        let start = Instant::now();
+        let outcome = engine.decide(lo, hi, cs);
+        times.push(start.elapsed().as_secs_f64() * 1e6);
+        counts[match outcome {
+            Outcome::Feasible(_) => 0,
+            Outcome::Infeasible => 1,
+            Outcome::Undecided => 2,
+        }] += 1;
+    }
+    times.sort_by(f64::total_cmp);
+    (times[times.len() / 2], times[times.len() * 9 / 10], counts)
 }
 
 fn main() {
     let args = Args::parse();
-    if args.cell.len() == 2 {
-        let start = Instant::now();
-        let (entries, report) =
-            edc_composition_cell(args.cell[0], args.cell[1], &Settings::default());
-        println!(
-            "cell {:?}: {} entries {:?} in {:.3} s",
-            args.cell,
-            entries.len(),
-            report,
-            start.elapsed().as_secs_f64()
-        );
-        return;
-    }
-    for r1 in [1u8, 5, 7, 13, 17] {
-        for r2 in [1u8, 6, 8, 14, 20] {
-            let start = Instant::now();
-            let (entries, report) = edc_composition_cell(r1, r2, &Settings::default());
-            println!(
-                "cell ({r1},{r2}): {} entries, sampled {} searched {} infeasible {} undecided {} boxes {} in {:.3} s",
-                entries.len(),
-                report.sampled,
-                report.searched_feasible,
-                report.proved_infeasible,
-                report.undecided,
-                report.boxes,
-                start.elapsed().as_secs_f64()
-            );
+
+    let n = 2;
+    let (a, b, c) = (fixed_point(n, 0.0, 0.0), fixed_point(n, 0.0, 1.0), free_point(n, 0, 1));
+    let mut two = Vec::new();
+    for r in 1..=20u8 {
+        for s in 1..=20u8 {
+            for (p, q, t) in [(&b, &c, &a), (&c, &a, &b), (&b, &a, &c)] {
+                let mut cs = region_constraints(&a, &b, &c, r);
+                cs.extend(region_constraints(p, q, t, s));
+                two.push((vec![-8.0; 2], vec![8.0; 2], cs));
+            }
         }
+    }
+    let (median, p90, counts) = time_decisions(&two);
+    println!(
+        "2 unknowns: {} decisions (EDC unary), median {median:.1} µs, p90 {p90:.1} µs; feasible {} infeasible {} undecided {}",
+        two.len(), counts[0], counts[1], counts[2]
+    );
+
+    let n = 4;
+    let (a, b, c, d) = (fixed_point(n, 0.0, 0.0), fixed_point(n, 0.0, 1.0), free_point(n, 0, 1), free_point(n, 2, 3));
+    let mut four = Vec::new();
+    for k in 0..300u32 {
+        let (r1, r2, r3) = ((k * 7 % 20 + 1) as u8, (k * 13 % 20 + 1) as u8, (k * 3 % 20 + 1) as u8);
+        let mut cs = region_constraints(&a, &b, &c, r1);
+        cs.extend(region_constraints(&b, &c, &d, r2));
+        cs.extend(region_constraints(&a, &b, &d, r3));
+        four.push((vec![-8.0; 4], vec![8.0; 4], cs));
+    }
+    let (median, p90, counts) = time_decisions(&four);
+    println!(
+        "4 unknowns: {} decisions (EDC composition triples), median {median:.1} µs, p90 {p90:.1} µs; feasible {} infeasible {} undecided {}",
+        four.len(), counts[0], counts[1], counts[2]
+    );
+
+    let settings = qrm::feasibility::Settings::default();
+    let start = Instant::now();
+    let (_, undecided) = edc_unary(&settings);
+    println!("EDC unary table: {:.2} s, {undecided} undecided", start.elapsed().as_secs_f64());
+    let start = Instant::now();
+    fdc_unary();
+    println!("FDC unary table: {:.2} s", start.elapsed().as_secs_f64());
+    let start = Instant::now();
+    let file = fdc_composition();
+    println!("FDC composition table: {:.2} s, {} entries", start.elapsed().as_secs_f64(), file.entries.len());
+    if !args.quick {
+        let start = Instant::now();
+        let (file, report) = edc_composition(&settings, || {});
+        println!(
+            "EDC composition table: {:.1} s on {} threads, {} entries, {} undecided",
+            start.elapsed().as_secs_f64(),
+            rayon::current_num_threads(),
+            file.entries.len(),
+            report.undecided
+        );
     }
 }

@@ -116,6 +116,31 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        /// Regions are invariant under rotation, scaling and translation, and swap under
+        /// reflection exactly as `mirror` says.
+        #[test]
+        fn regions_are_similarity_invariant(
+            x in -3.0f64..3.0, y in -3.0f64..3.0,
+            angle in 0.0f64..6.3, scale in 0.01f64..100.0, tx in -50.0f64..50.0, ty in -50.0f64..50.0,
+        ) {
+            let a = Point::new(0.0, 0.0);
+            let b = Point::new(0.0, 1.0);
+            let c = Point::new(x, y);
+            // Stay clear of boundaries, where rounding may legitimately flip a sign.
+            let values = boundary_values(&a, &b, &c);
+            proptest::prop_assume!(values.iter().all(|v| v.abs() > 1e-6));
+            let r = classify(a, b, c).unwrap();
+            let t = |p: Point| Point::new(
+                tx + scale * (angle.cos() * p.x - angle.sin() * p.y),
+                ty + scale * (angle.sin() * p.x + angle.cos() * p.y),
+            );
+            proptest::prop_assert_eq!(classify(t(a), t(b), t(c)), Some(r));
+            let m = |p: Point| t(Point::new(-p.x, p.y));
+            proptest::prop_assert_eq!(classify(m(a), m(b), m(c)), Some(mirror(r)));
+        }
+    }
+
     #[test]
     fn worked_example_of_state_2() {
         // 000 §III-B: AB:C = 2 ⇔ α > 0, β − 1 > 0, α² + β² − 2β > 0.
