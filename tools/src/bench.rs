@@ -40,7 +40,11 @@ fn main() {
     let args = Args::parse();
 
     let n = 2;
-    let (a, b, c) = (fixed_point(n, 0.0, 0.0), fixed_point(n, 0.0, 1.0), free_point(n, 0, 1));
+    let (a, b, c) = (
+        fixed_point(n, 0.0, 0.0),
+        fixed_point(n, 0.0, 1.0),
+        free_point(n, 0, 1),
+    );
     let mut two = Vec::new();
     for r in 1..=20u8 {
         for s in 1..=20u8 {
@@ -58,10 +62,19 @@ fn main() {
     );
 
     let n = 4;
-    let (a, b, c, d) = (fixed_point(n, 0.0, 0.0), fixed_point(n, 0.0, 1.0), free_point(n, 0, 1), free_point(n, 2, 3));
+    let (a, b, c, d) = (
+        fixed_point(n, 0.0, 0.0),
+        fixed_point(n, 0.0, 1.0),
+        free_point(n, 0, 1),
+        free_point(n, 2, 3),
+    );
     let mut four = Vec::new();
     for k in 0..300u32 {
-        let (r1, r2, r3) = ((k * 7 % 20 + 1) as u8, (k * 13 % 20 + 1) as u8, (k * 3 % 20 + 1) as u8);
+        let (r1, r2, r3) = (
+            (k * 7 % 20 + 1) as u8,
+            (k * 13 % 20 + 1) as u8,
+            (k * 3 % 20 + 1) as u8,
+        );
         let mut cs = region_constraints(&a, &b, &c, r1);
         cs.extend(region_constraints(&b, &c, &d, r2));
         cs.extend(region_constraints(&a, &b, &d, r3));
@@ -76,13 +89,20 @@ fn main() {
     let settings = qrm::feasibility::Settings::default();
     let start = Instant::now();
     let (_, undecided) = edc_unary(&settings);
-    println!("EDC unary table: {:.2} s, {undecided} undecided", start.elapsed().as_secs_f64());
+    println!(
+        "EDC unary table: {:.2} s, {undecided} undecided",
+        start.elapsed().as_secs_f64()
+    );
     let start = Instant::now();
     fdc_unary();
     println!("FDC unary table: {:.2} s", start.elapsed().as_secs_f64());
     let start = Instant::now();
     let file = fdc_composition();
-    println!("FDC composition table: {:.2} s, {} entries", start.elapsed().as_secs_f64(), file.entries.len());
+    println!(
+        "FDC composition table: {:.2} s, {} entries",
+        start.elapsed().as_secs_f64(),
+        file.entries.len()
+    );
     if !args.quick {
         let start = Instant::now();
         let (file, report) = edc_composition(&settings, || {});

@@ -95,7 +95,9 @@ mod tests {
         let b = Point2::new(0.0, 1.0);
         let v = boundary_values(&a, &b, &Point2::new(-2.0, 3.0));
         assert!(v.iter().all(|&x| x > 0.0), "{v:?}");
-        let v = boundary_values(&a, &b, &Point2::new(0.3, 0.2));
-        assert!(v.iter().all(|&x| x < 0.0), "{v:?}");
+        // Just behind A on the right: only "outside the circle about B" holds.
+        let v = boundary_values(&a, &b, &Point2::new(0.3, -0.2));
+        let signs: Vec<bool> = v.iter().map(|&x| x > 0.0).collect();
+        assert_eq!(signs, [false, false, false, false, false, true], "{v:?}");
     }
 }
