@@ -41,9 +41,9 @@ fn set(rs: &[u8]) -> RelationSet {
 #[test]
 fn every_cell_of_table_i_from_sampled_triples() {
     let mut rng = rng(1);
-    let mut left = vec![RelationSet::EMPTY; 20];
-    let mut right = vec![RelationSet::EMPTY; 20];
-    let mut inverse = vec![RelationSet::EMPTY; 20];
+    let mut left = [RelationSet::EMPTY; 20];
+    let mut right = [RelationSet::EMPTY; 20];
+    let mut inverse = [RelationSet::EMPTY; 20];
     let mut seen = 0usize;
     // Points drawn in the canonical frame (to reach every region, incl. the lunes) and mapped by
     // random similarities (to exercise scale and orientation), plus fully random triples.

@@ -115,9 +115,9 @@ fn stationary_point(
     // 2 A_FF x_F = −(b_F + 2 A_FX x_X)
     for (r, &i) in free.iter().enumerate() {
         let mut v = -q.b[i];
-        for j in 0..q.n {
+        for (j, xj) in x.iter().enumerate() {
             if !free.contains(&j) {
-                v -= 2.0 * q.a(i, j) * x[j];
+                v -= 2.0 * q.a(i, j) * xj;
             }
         }
         rhs[r] = v;

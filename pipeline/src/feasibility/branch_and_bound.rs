@@ -132,8 +132,8 @@ impl BranchAndBound {
 
             // Witness candidates: centre and random points.
             for t in 0..=s.samples_per_box {
-                for i in 0..n {
-                    candidate[i] = if t == 0 {
+                for (i, v) in candidate.iter_mut().enumerate() {
+                    *v = if t == 0 {
                         0.5 * (cell.lo[i] + cell.hi[i])
                     } else {
                         rng.random_range(cell.lo[i]..=cell.hi[i])

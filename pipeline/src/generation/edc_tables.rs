@@ -270,7 +270,8 @@ pub fn edc_composition(
         .filter(|&r1| SIGNS[r1 as usize - 1][0] > 0)
         .flat_map(|r1| (1..=REGIONS).map(move |r2| (r1, r2)))
         .collect();
-    let searched: Vec<((u8, u8), (Vec<CompositionEntry>, CompositionReport), f64)> = left
+    type Searched = ((u8, u8), (Vec<CompositionEntry>, CompositionReport), f64);
+    let searched: Vec<Searched> = left
         .par_iter()
         .map(|&cell| {
             let start = std::time::Instant::now();

@@ -47,7 +47,8 @@ pub fn fdc_unary() -> UnaryFile {
 /// The FDC composition table with an exact rational witness `x1 x2 x3 x4` (C, D) per entry.
 pub fn fdc_composition() -> CompositionFile {
     let (a, b) = frame();
-    let per_c: Vec<Vec<((u8, u8, u8), Vec<String>)>> = candidate_third_points()
+    type Found = ((u8, u8, u8), Vec<String>);
+    let per_c: Vec<Vec<Found>> = candidate_third_points()
         .par_iter()
         .filter(|c| **c != b)
         .map(|c| {
