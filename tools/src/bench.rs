@@ -15,6 +15,9 @@ struct Args {
     /// Skip regenerating the full EDC composition table (the slow part).
     #[arg(long)]
     quick: bool,
+    /// Only time the EDC composition cells `R1 R2` (repeatable), with their search counts.
+    #[arg(long, num_args = 2, value_names = ["AB_C", "BC_D"])]
+    cell: Vec<u8>,
 }
 
 /// Median and 90th percentile in microseconds, with the outcome counts.
@@ -38,6 +41,22 @@ fn time_decisions(problems: &[(Vec<f64>, Vec<f64>, Vec<Quadratic>)]) -> (f64, f6
 
 fn main() {
     let args = Args::parse();
+    if !args.cell.is_empty() {
+        for pair in args.cell.chunks(2) {
+            let start = Instant::now();
+            let (entries, report) = qrm::generation::edc_composition_cell(
+                pair[0],
+                pair[1],
+                &qrm::feasibility::Settings::default(),
+            );
+            println!(
+                "cell ({},{}): {} possible, {} by sampling, {} by search, {} impossible, {} undecided, {} boxes, {:.2} s",
+                pair[0], pair[1], entries.len(), report.sampled, report.searched_feasible,
+                report.proved_infeasible, report.undecided, report.boxes, start.elapsed().as_secs_f64()
+            );
+        }
+        return;
+    }
 
     let n = 2;
     let (a, b, c) = (

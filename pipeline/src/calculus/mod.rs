@@ -26,7 +26,7 @@ pub trait Calculus: Send + Sync + 'static {
     /// The committed operator tables.
     fn tables() -> &'static OperatorTables;
 
-    /// The universal relation: nothing known.
+    /// The relation between three distinct landmarks when nothing is known.
     fn universe() -> RelationSet {
         RelationSet::all(Self::RELATIONS as usize)
     }

@@ -15,7 +15,7 @@ mod arrangement;
 
 pub use arrangement::{candidate_third_points, classify_exact, faces_of_fourth_point};
 
-use crate::calculus::{Calculus, CompositionFile, OperatorTables, UnaryFile};
+use crate::calculus::{Calculus, CompositionFile, OperatorTables, RelationSet, UnaryFile};
 use crate::geometry::{boundary_values, Coordinate, Point, Point2};
 use num_traits::Zero;
 use std::sync::OnceLock;
@@ -77,6 +77,11 @@ impl Calculus for Fdc {
     /// boundary value is exactly zero.
     fn classify(a: Point, b: Point, c: Point) -> Option<u8> {
         classify_generic(&a, &b, &c)
+    }
+
+    /// Distinct landmarks never coincide: relations 5 (C = B) and 11 (C = A) are excluded.
+    fn universe() -> RelationSet {
+        RelationSet::all(RELATIONS as usize).without(5).without(11)
     }
 
     fn tables() -> &'static OperatorTables {
