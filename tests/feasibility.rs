@@ -154,24 +154,6 @@ fn multi_alternative_search_agrees_with_single_searches() {
     }
 }
 
-fn random_quadratic(n: usize, coefs: &[f64]) -> Quadratic {
-    let mut q = Quadratic::zero(n);
-    let mut k = 0;
-    for i in 0..n {
-        for j in i..n {
-            q.a[i * n + j] = coefs[k];
-            q.a[j * n + i] = coefs[k];
-            k += 1;
-        }
-    }
-    for i in 0..n {
-        q.b[i] = coefs[k];
-        k += 1;
-    }
-    q.c = coefs[k];
-    q
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
 
@@ -184,7 +166,7 @@ proptest! {
         m in 1usize..=3,
     ) {
         let per = n * (n + 1) / 2 + n + 1;
-        let cs: Vec<Quadratic> = (0..m).map(|j| random_quadratic(n, &coefs[(j * 7) % (30 - per)..][..per])).collect();
+        let cs: Vec<Quadratic> = (0..m).map(|j| Quadratic::from_packed(n, &coefs[(j * 7) % (30 - per)..][..per])).collect();
         let lo = vec![-2.0; n];
         let hi = vec![2.0; n];
         match engine().decide(&lo, &hi, &cs) {

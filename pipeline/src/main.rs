@@ -51,7 +51,7 @@ enum Command {
         #[arg(allow_hyphen_values = true)]
         c: String,
     },
-    /// COMPOSE(AB:C, BC:D) → AB:D for relation sets, e.g. `compose {1,5,11} {5}`.
+    /// COMPOSE(AB:C, BC:D) → AB:D for relation sets, e.g. `compose 1,5,11 5`.
     Compose {
         #[arg(long, value_enum, default_value = "edc")]
         calculus: CalculusName,
@@ -125,7 +125,7 @@ fn demo() {
         Fdc::classify(a, b, c)
     );
     println!(
-        "\nTry: pipeline compose {{7,13}} {{14}}   pipeline unary left {{7}}   pipeline tables"
+        "\nTry: pipeline compose 7,13 14   pipeline unary left 7   pipeline tables   pipeline --help"
     );
 }
 

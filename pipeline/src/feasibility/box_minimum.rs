@@ -210,24 +210,6 @@ mod tests {
         }
     }
 
-    fn quadratic(n: usize, coefs: &[f64]) -> Quadratic {
-        let mut q = Quadratic::zero(n);
-        let mut k = 0;
-        for i in 0..n {
-            for j in i..n {
-                q.a[i * n + j] = coefs[k];
-                q.a[j * n + i] = coefs[k];
-                k += 1;
-            }
-        }
-        for i in 0..n {
-            q.b[i] = coefs[k];
-            k += 1;
-        }
-        q.c = coefs[k];
-        q
-    }
-
     proptest! {
         /// The exact minimum never exceeds any grid sample and is attained up to the grid's
         /// resolution; the interval bound is never above it.
@@ -237,7 +219,7 @@ mod tests {
             corner in proptest::collection::vec(-2.0f64..2.0, 3),
             width in proptest::collection::vec(0.1f64..2.0, 3),
         ) {
-            let q = quadratic(3, &coefs);
+            let q = Quadratic::from_packed(3, &coefs);
             let lo: Vec<f64> = corner.clone();
             let hi: Vec<f64> = corner.iter().zip(&width).map(|(c, w)| c + w).collect();
             let exact = minimum_over_box(&q, &lo, &hi);

@@ -89,6 +89,28 @@ impl Quadratic {
         }
     }
 
+    /// From packed coefficients: the upper triangle of `A` row by row (`a_00, a_01, …, a_11, …`),
+    /// then `b`, then `c`; `n(n+1)/2 + n + 1` numbers in all.
+    pub fn from_packed(n: usize, coefs: &[f64]) -> Quadratic {
+        assert_eq!(
+            coefs.len(),
+            n * (n + 1) / 2 + n + 1,
+            "packed quadratic length"
+        );
+        let mut q = Quadratic::zero(n);
+        let mut k = 0;
+        for i in 0..n {
+            for j in i..n {
+                q.a[i * n + j] = coefs[k];
+                q.a[j * n + i] = coefs[k];
+                k += 1;
+            }
+        }
+        q.b.copy_from_slice(&coefs[k..k + n]);
+        q.c = coefs[k + n];
+        q
+    }
+
     pub fn from_linear(l: &Linear) -> Quadratic {
         Quadratic {
             n: l.b.len(),

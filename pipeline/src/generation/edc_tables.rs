@@ -138,18 +138,6 @@ fn search_cell(
     let a = fixed_point(n, 0.0, 0.0);
     let b = fixed_point(n, 0.0, 1.0);
     let c = free_point(n, 0, 1);
-    let d = free_point(n, 2, 3);
-    let mut common = region_constraints(&a, &b, &c, ab_c);
-    common.extend(region_constraints(&b, &c, &d, bc_d));
-    let (lower, upper) = search_box(n);
-    let full = Problem {
-        lower,
-        upper,
-        common,
-        alternatives: (1..=REGIONS)
-            .map(|r| region_constraints(&a, &b, &d, r))
-            .collect(),
-    };
     let mut report = CompositionReport::default();
     let mut witnesses: Vec<Option<Vec<String>>> = vec![None; REGIONS as usize];
 
@@ -170,6 +158,7 @@ fn search_cell(
             continue;
         };
         let k = r3 as usize - 1;
+        // Rounding in the placement of D may move C or D across a boundary: re-check.
         if witnesses[k].is_none() && witness_classifies(&x, ab_c, bc_d, r3) {
             witnesses[k] = Some(tidy_witness(&x, |w| witness_classifies(w, ab_c, bc_d, r3)));
             report.sampled += 1;
@@ -208,8 +197,7 @@ fn search_cell(
                 free_point(n, 2, 3)
             };
             let reach = if relative_to_c { 2.0 } else { 1.0 } * EDC_SEARCH_HALF_WIDTH;
-            let mut lower = full.lower.clone();
-            let mut upper = full.upper.clone();
+            let (mut lower, mut upper) = search_box(n);
             lower[2..].fill(-reach);
             upper[2..].fill(reach);
             let mut constraints = region_constraints(&a, &b, &c, ab_c);

@@ -1,0 +1,66 @@
+//! The `pipeline` binary: answers on good input, exit code 2 and a message naming the problem
+//! on bad input.
+
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pipeline"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).trim().to_string()
+}
+
+#[test]
+fn answers() {
+    let o = run(&["classify", "0,0", "0,1", "-2,3"]);
+    assert!(o.status.success());
+    assert_eq!(stdout(&o), "1");
+    assert_eq!(
+        stdout(&run(&[
+            "classify",
+            "--calculus",
+            "fdc",
+            "0,0",
+            "0,1",
+            "0,2"
+        ])),
+        "2"
+    );
+    assert_eq!(stdout(&run(&["classify", "0,0", "0,1", "0,3"])), "boundary");
+    assert_eq!(
+        stdout(&run(&["compose", "1,5,11", "5"])),
+        "{1,5,11,12,17,18,19,20}"
+    );
+    assert_eq!(stdout(&run(&["unary", "left", "{6,7}"])), "{1,5,11}");
+    let demo = run(&["demo"]);
+    assert!(demo.status.success());
+    assert!(stdout(&demo).contains("{1,5,11,12,17,18,19,20}"));
+    assert!(stdout(&run(&["tables"])).contains("0 undecided"));
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    for (args, needle) in [
+        (
+            vec!["classify", "0,0", "0,1", "x,3"],
+            "bad x in point \"x,3\"",
+        ),
+        (vec!["classify", "0,0", "0,1", "1"], "must be written x,y"),
+        (vec!["classify", "1,1", "1,1", "0,0"], "A and B coincide"),
+        (vec!["compose", "1,21", "5"], "outside 1..=20"),
+        (
+            vec!["compose", "--calculus", "fdc", "16", "5"],
+            "outside 1..=15",
+        ),
+        (vec!["unary", "left", "{1,"], "missing '}'"),
+    ] {
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}
