@@ -95,10 +95,10 @@ fn parse_set(text: &str, relations: u8) -> Result<RelationSet> {
     Ok(set)
 }
 
-fn tables(c: CalculusName) -> (&'static OperatorTables, &'static str) {
+fn tables(c: CalculusName) -> &'static OperatorTables {
     match c {
-        CalculusName::Edc => (Edc::tables(), Edc::NAME),
-        CalculusName::Fdc => (Fdc::tables(), Fdc::NAME),
+        CalculusName::Edc => Edc::tables(),
+        CalculusName::Fdc => Fdc::tables(),
     }
 }
 
@@ -169,7 +169,7 @@ fn run(cli: Cli) -> Result<()> {
             ab_c,
             bc_d,
         } => {
-            let (t, _) = tables(calculus);
+            let t = tables(calculus);
             let (s1, s2) = (
                 parse_set(&ab_c, t.relations())?,
                 parse_set(&bc_d, t.relations())?,
@@ -181,7 +181,7 @@ fn run(cli: Cli) -> Result<()> {
             operator,
             set,
         } => {
-            let (t, _) = tables(calculus);
+            let t = tables(calculus);
             let s = parse_set(&set, t.relations())?;
             let op = match operator {
                 Operator::Left => UnaryOperator::Left,

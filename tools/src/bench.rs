@@ -16,7 +16,7 @@ struct Args {
     #[arg(long)]
     quick: bool,
     /// Only time the EDC composition cells `R1 R2` (repeatable), with their search counts.
-    #[arg(long, num_args = 2, value_names = ["AB_C", "BC_D"])]
+    #[arg(long, num_args = 2, value_names = ["AB_C", "BC_D"], value_parser = clap::value_parser!(u8).range(1..=20))]
     cell: Vec<u8>,
 }
 

@@ -1,5 +1,5 @@
 use super::relation_set::RelationSet;
-use super::table_format::{CompositionFile, UnaryFile};
+use super::table_format::{CompositionFile, TableFormatError, UnaryFile};
 
 /// The three unary operators of 000 §III-A.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -10,22 +10,6 @@ pub enum UnaryOperator {
     Right,
     /// `AB:C → BA:C`.
     Inverse,
-}
-
-impl UnaryOperator {
-    pub const ALL: [UnaryOperator; 3] = [
-        UnaryOperator::Left,
-        UnaryOperator::Right,
-        UnaryOperator::Inverse,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            UnaryOperator::Left => "LEFT",
-            UnaryOperator::Right => "RIGHT",
-            UnaryOperator::Inverse => "INVERSE",
-        }
-    }
 }
 
 /// Lookup tables of one calculus, applied to sets by union over members (000 §III-C).
@@ -41,20 +25,33 @@ pub struct OperatorTables {
 
 impl OperatorTables {
     /// Builds the tables from parsed files; undecided composition entries count as possible.
-    pub fn from_files(unary: &UnaryFile, composition: &CompositionFile) -> OperatorTables {
+    /// The two files must describe the same calculus.
+    pub fn from_files(
+        unary: &UnaryFile,
+        composition: &CompositionFile,
+    ) -> Result<OperatorTables, TableFormatError> {
+        if unary.calculus != composition.calculus || unary.relations != composition.relations {
+            return Err(TableFormatError {
+                line: 0,
+                reason: format!(
+                    "unary table is {} with {} relations but composition table is {} with {}",
+                    unary.calculus, unary.relations, composition.calculus, composition.relations
+                ),
+            });
+        }
         let n = unary.relations as usize;
         let mut compose = vec![RelationSet::EMPTY; n * n];
         for e in &composition.entries {
             let cell = &mut compose[(e.ab_c as usize - 1) * n + e.bc_d as usize - 1];
             *cell = cell.with(e.ab_d);
         }
-        OperatorTables {
+        Ok(OperatorTables {
             relations: unary.relations,
             left: unary.left.clone(),
             right: unary.right.clone(),
             inverse: unary.inverse.clone(),
             compose,
-        }
+        })
     }
 
     pub fn relations(&self) -> u8 {

@@ -20,14 +20,6 @@ impl RelationSet {
         }
     }
 
-    pub const fn from_bits(bits: u32) -> RelationSet {
-        RelationSet(bits)
-    }
-
-    pub const fn bits(self) -> u32 {
-        self.0
-    }
-
     /// The singleton `{r}`; `r` is 1-based as in the papers.
     pub const fn single(r: u8) -> RelationSet {
         RelationSet(1u32 << (r - 1))

@@ -24,16 +24,23 @@ fn err(line: usize, reason: impl Into<String>) -> TableFormatError {
     }
 }
 
-/// Header fields shared by both files.
+/// Header fields shared by both files: the `# calculus` and `# relations` comments before the
+/// first data line, each exactly once.
 fn read_header(text: &str) -> Result<(String, u8), TableFormatError> {
     let mut calculus = None;
     let mut relations = None;
     for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if !line.is_empty() && !line.starts_with('#') {
+            break;
+        }
         let Some(rest) = line.strip_prefix("# ") else {
             continue;
         };
         if let Some(name) = rest.strip_prefix("calculus ") {
-            calculus = Some(name.trim().to_string());
+            if calculus.replace(name.trim().to_string()).is_some() {
+                return Err(err(i + 1, "'# calculus' given twice"));
+            }
         } else if let Some(n) = rest.strip_prefix("relations ") {
             let n: u8 = n
                 .trim()
@@ -42,7 +49,9 @@ fn read_header(text: &str) -> Result<(String, u8), TableFormatError> {
             if !(1..=32).contains(&n) {
                 return Err(err(i + 1, "relation count must be 1..=32"));
             }
-            relations = Some(n);
+            if relations.replace(n).is_some() {
+                return Err(err(i + 1, "'# relations' given twice"));
+            }
         }
     }
     Ok((
@@ -287,6 +296,7 @@ mod tests {
         assert!(CompositionFile::parse("# calculus X\n# relations 3\nF 1 1 1\n").is_err());
         assert!(CompositionFile::parse("# calculus X\n# relations 3\nU 1 1 2\nU 1 1 1\n").is_err());
         assert!(CompositionFile::parse("# relations 3\n").is_err());
+        assert!(CompositionFile::parse("# calculus X\n# relations 3\n# relations 4\n").is_err());
     }
 
     #[test]

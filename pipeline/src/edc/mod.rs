@@ -36,7 +36,7 @@ impl Calculus for Edc {
             let unary = UnaryFile::parse(UNARY_TABLE).expect("committed tables/edc_unary.txt");
             let composition = CompositionFile::parse(COMPOSITION_TABLE)
                 .expect("committed tables/edc_composition.txt");
-            OperatorTables::from_files(&unary, &composition)
+            OperatorTables::from_files(&unary, &composition).expect("committed edc tables agree")
         })
     }
 }

@@ -90,7 +90,7 @@ impl Calculus for Fdc {
             let unary = UnaryFile::parse(UNARY_TABLE).expect("committed tables/fdc_unary.txt");
             let composition = CompositionFile::parse(COMPOSITION_TABLE)
                 .expect("committed tables/fdc_composition.txt");
-            OperatorTables::from_files(&unary, &composition)
+            OperatorTables::from_files(&unary, &composition).expect("committed fdc tables agree")
         })
     }
 }

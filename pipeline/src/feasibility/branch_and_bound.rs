@@ -7,7 +7,7 @@
 //!   there, each finished globally as soon as a witness is found.
 
 use super::box_minimum::minimum_over_box;
-use super::propagation::contract;
+use super::propagation::{contract, WIDEN};
 use super::relaxation::joint_relaxation;
 use super::{Outcome, Problem, Quadratic};
 use rand::{Rng, SeedableRng};
@@ -39,7 +39,7 @@ impl Default for Settings {
             seed: 0x9E37_79B9_7F4A_7C15,
             max_boxes: 200_000,
             min_relative_width: 1e-9,
-            margin: 1e-9,
+            margin: 1e-7,
             use_relaxation: true,
             use_propagation: true,
             samples_per_box: 2,
@@ -259,11 +259,11 @@ fn snap_outward(cell: &mut Cell, problem: &Problem) {
         }
         let step = total * 2f64.powi((w / total / 64.0).log2().floor() as i32);
         if step > 0.0 && step.is_finite() {
-            // Propagation pads its bounds by a few ulps for safety; a bound within that pad of a
-            // grid point snaps to it rather than a whole step outward.
+            // Propagation pads its bounds by `WIDEN` against rounding; a bound within that pad
+            // of a grid point snaps to it rather than a whole step outward.
             let snap = |v: f64, outward: fn(f64) -> f64| {
                 let k = (v / step).round();
-                if (v - k * step).abs() <= 1e-11 * (1.0 + v.abs()) {
+                if (v - k * step).abs() <= 2.0 * WIDEN * (1.0 + v.abs()) {
                     k * step
                 } else {
                     outward(v / step) * step

@@ -36,8 +36,10 @@ impl Outcome {
 }
 
 /// A family of conjunctions sharing a box and `common` constraints: alternative `k` asks for
-/// `common ∧ alternatives[k]`. Deciding them together shares every box's work (e.g. the 20
-/// candidate regions of one composition-table cell, or of one measured triple).
+/// `common ∧ alternatives[k]`. Deciding them together shares every box's work, e.g. the 20
+/// candidate regions of one measured triple. (Alternatives are only propagated on boxes where a
+/// single one is left, so problems whose alternatives contract the box strongly — like the
+/// composition table's — are faster decided one by one.)
 #[derive(Clone, Debug)]
 pub struct Problem {
     pub lower: Vec<f64>,

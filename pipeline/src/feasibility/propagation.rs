@@ -6,7 +6,7 @@
 use super::quadratic::Quadratic;
 
 /// Relative widening applied to every projected interval so rounding never removes a point.
-const WIDEN: f64 = 1e-12;
+pub(crate) const WIDEN: f64 = 1e-12;
 
 /// Interval of `a x² + p x` for `p ∈ [p_lo, p_hi]`: the set `{x ∈ [lo, hi] : a x² + p x + r ≤ 0
 /// for some p}` as a hull `[lo', hi']`, or `None` if empty.

@@ -4,8 +4,8 @@
 //! The paper bounds each constraint separately; a box straddling a boundary that two constraints
 //! share (`q < 0` and `−q < 0`, or curves that touch) then never gets pruned. Here all
 //! constraints of the box share one set of lifted variables `w_kl ≈ x_k x_l`, and one LP asks for
-//! the largest common margin `t` with `lin_j(x, w) + t·s_j ≤ 0` for every `j`. If even the
-//! relaxation has no positive margin, the box holds no strictly feasible point.
+//! the largest common margin `t` with `lin_j(x, w) + t·s_j ≤ 0` for every `j`. If a dual bound
+//! proves that even the relaxation has no margin above `Settings::margin`, neither has the box.
 //!
 //! The box is first mapped to `[−1, 1]ⁿ` (centre and half-widths) so that the LP is well
 //! conditioned however small the box has become.
@@ -19,7 +19,9 @@ use clarabel::solver::{
 
 /// Result of the joint relaxation on one box.
 pub struct RelaxationBound {
-    /// Largest margin of the relaxation, in units of each constraint's coefficient scale.
+    /// Certified upper bound on the largest common margin of the relaxation, in units of each
+    /// constraint's coefficient scale (from the LP dual, so solver inaccuracy cannot make it
+    /// too small).
     pub margin: f64,
     /// The relaxation's optimal point in the original unknowns: a good witness candidate.
     pub point: Vec<f64>,
@@ -154,18 +156,42 @@ pub fn joint_relaxation(
         .ok()?;
     let mut solver = DefaultSolver::new(&p, &objective, &a, &rhs, &cones, settings).ok()?;
     solver.solve();
-    match solver.solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => {}
-        // The relaxation always contains u = 0, w = 0 with a small enough t, so primal
-        // infeasibility can only be numerical: do not prune on it.
-        _ => return None,
+    // A rigorous upper bound on the relaxation's optimum from the (approximate) dual: for any
+    // z ≥ 0 scaled so that (Aᵀz)_t = 1, every feasible y has
+    // t = zᵀAy − Σ_{i≠t} r_i y_i ≤ zᵀb + Σ_{i≠t} |r_i|, with r = Aᵀz − e_t and |y_i| ≤ 1 for
+    // every u and w (the box and McCormick rows imply it). Interior-point primal values lie
+    // below the optimum by up to the solver's gap, so they must not be used to refute.
+    if !matches!(
+        solver.solution.status,
+        SolverStatus::Solved | SolverStatus::AlmostSolved
+    ) {
+        return None;
     }
+    let z: Vec<f64> = solver.solution.z.iter().map(|v| v.max(0.0)).collect();
+    let mut residual = vec![0.0; nv];
+    for (row, &zr) in rows.iter().zip(&z) {
+        for &(c, v) in row {
+            residual[c] += zr * v;
+        }
+    }
+    let t_coefficient = residual[t];
+    if t_coefficient <= 0.0 {
+        return None;
+    }
+    let upper_bound = (z.iter().zip(&rhs).map(|(z, b)| z * b).sum::<f64>()
+        + residual
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| i != t)
+            .map(|(_, r)| r.abs())
+            .sum::<f64>())
+        / t_coefficient;
     let x = &solver.solution.x;
     let point = (0..n)
         .map(|i| m[i] + h[i] * x[i].clamp(-1.0, 1.0))
         .collect();
     Some(RelaxationBound {
-        margin: x[t],
+        margin: upper_bound,
         point,
     })
 }

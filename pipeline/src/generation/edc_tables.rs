@@ -1,14 +1,15 @@
 //! EDC tables by feasibility (000 §III-B): A=(0,0), B=(0,1), C=(x1,x2), D=(x3,x4); a triple of
 //! regions is possible exactly when the conjunction of their constraints has a solution.
 //!
-//! Each cell `(AB:C, BC:D)` is decided as one multi-alternative search over the 20 candidate
-//! `AB:D` regions. Witnesses are first looked for by sampling configurations directly inside the
-//! two given regions (cheap, and most possible triples are found this way); the branch and bound
-//! then proves the rest impossible or finds their witnesses.
+//! For each cell `(AB:C, BC:D)`, witnesses are first looked for by sampling configurations
+//! directly inside the two given regions (cheap; most possible triples are found this way); then
+//! each remaining candidate `AB:D` gets its own branch and bound, which proves it impossible for
+//! C, D in `[−R, R]²` or finds a witness. Witnesses found by sampling may lie outside that box:
+//! a witness proves possibility wherever it is.
 
 use crate::calculus::{CompositionEntry, CompositionFile, EntryKind, RelationSet, UnaryFile};
 use crate::edc::{classify, fixed_point, free_point, mirror, region_constraints, REGIONS, SIGNS};
-use crate::feasibility::{BranchAndBound, Linear, Outcome, Problem, Settings};
+use crate::feasibility::{BranchAndBound, Linear, Outcome, Problem, Quadratic, Settings};
 use crate::geometry::{Point, Point2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -203,6 +204,17 @@ fn search_cell(
             let mut constraints = region_constraints(&a, &b, &c, ab_c);
             constraints.extend(region_constraints(&b, &c, &d, bc_d));
             constraints.extend(region_constraints(&a, &b, &d, r3));
+            if relative_to_c {
+                // Keep D in the same box as the first parametrisation, so that "impossible"
+                // means one thing: no configuration with C and D in [−R, R]².
+                let r = Linear::constant(n, EDC_SEARCH_HALF_WIDTH);
+                for coordinate in [&d.x, &d.y] {
+                    constraints.push(Quadratic::from_linear(&(coordinate.clone() - r.clone())));
+                    constraints.push(Quadratic::from_linear(
+                        &(coordinate.scaled(-1.0) - r.clone()),
+                    ));
+                }
+            }
             let problem = Problem::single(lower, upper, constraints);
             let (mut outcomes, stats) = BranchAndBound::new(pass_settings.clone()).solve(&problem);
             report.boxes += stats.boxes;
