@@ -183,7 +183,7 @@ impl BranchAndBound {
                 continue;
             }
 
-            // Split the relatively widest unknown at its midpoint.
+            // Split the relatively widest unknown at its simplest dyadic value (see `split_point`).
             let (axis, rel) = (0..n)
                 .map(|i| {
                     (
