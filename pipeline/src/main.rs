@@ -6,7 +6,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use qrm::calculus::{Calculus, CompositionFile, OperatorTables, RelationSet, UnaryOperator};
 use qrm::edc::Edc;
 use qrm::fdc::Fdc;
-use qrm::geometry::Point;
+use qrm::geometry::{boundary_values, Point};
 use std::process::ExitCode;
 
 #[derive(Parser, Debug)]
@@ -154,6 +154,9 @@ fn run(cli: Cli) -> Result<()> {
             let (a, b, c) = (parse_point(&a)?, parse_point(&b)?, parse_point(&c)?);
             if a == b {
                 bail!("A and B coincide: the frame A→B is undefined");
+            }
+            if boundary_values(&a, &b, &c).iter().any(|v| !v.is_finite()) {
+                bail!("coordinates too large: squared distances overflow a 64-bit float");
             }
             let r = match calculus {
                 CalculusName::Edc => Edc::classify(a, b, c),

@@ -51,6 +51,14 @@ fn bad_input_is_a_clear_error() {
         ),
         (vec!["classify", "0,0", "0,1", "1"], "must be written x,y"),
         (vec!["classify", "1,1", "1,1", "0,0"], "A and B coincide"),
+        (
+            vec!["classify", "0,0", "0,1", "1e200,1e200"],
+            "coordinates too large",
+        ),
+        (
+            vec!["classify", "0,0", "0,1", "nan,1"],
+            "finite coordinates",
+        ),
         (vec!["compose", "1,21", "5"], "outside 1..=20"),
         (
             vec!["compose", "--calculus", "fdc", "16", "5"],
