@@ -6,7 +6,9 @@ mod region;
 
 pub use adjacency::adjacency;
 pub use constraints::{fixed_point, free_point, region_constraints};
-pub use region::{classify, defining_boundaries, mirror, region_of_signs, LUNE, REGIONS, SIGNS};
+pub use region::{
+    classify, defining_boundaries, is_left, mirror, region_of_signs, LUNE, REGIONS, SIGNS,
+};
 
 use crate::calculus::{Calculus, CompositionFile, OperatorTables, UnaryFile};
 use crate::geometry::Point;

@@ -52,6 +52,11 @@ pub fn region_of_signs(signs: [i8; 6]) -> Option<u8> {
     SIGNS.iter().position(|s| *s == signs).map(|i| i as u8 + 1)
 }
 
+/// Whether `region` lies left of AB.
+pub fn is_left(region: u8) -> bool {
+    SIGNS[region as usize - 1][0] > 0
+}
+
 /// The region's mirror image across the line AB (left and right swapped): reflection maps a
 /// configuration with `AB:C = r` to one with `AB:C = mirror(r)` in every frame at once.
 pub fn mirror(region: u8) -> u8 {

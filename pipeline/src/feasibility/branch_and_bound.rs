@@ -124,7 +124,7 @@ impl BranchAndBound {
                     stats.propagation_refutations += 1;
                     continue;
                 }
-                snap_outward(&mut cell, problem);
+                snap_outward(&mut cell, problem, &widths);
             }
             if refuted(problem.common.iter(), &cell, s.margin) {
                 continue;
@@ -197,11 +197,7 @@ impl BranchAndBound {
                 unresolved |= cell.open;
                 continue;
             }
-            let mid = split_point(
-                cell.lo[axis],
-                cell.hi[axis],
-                problem.upper[axis] - problem.lower[axis],
-            );
+            let mid = split_point(cell.lo[axis], cell.hi[axis], widths[axis]);
             let mut upper = Cell {
                 lo: cell.lo.clone(),
                 hi: cell.hi.clone(),
@@ -250,9 +246,8 @@ fn split_point(lo: f64, hi: f64, total: f64) -> f64 {
 /// the box's width). Midpoint splits then keep landing on simple values such as 0, 1 and ½,
 /// which are where EDC boundaries meet: boxes that end exactly on a shared boundary can be
 /// refuted by exact bounds instead of straddling it forever.
-fn snap_outward(cell: &mut Cell, problem: &Problem) {
-    for i in 0..cell.lo.len() {
-        let total = problem.upper[i] - problem.lower[i];
+fn snap_outward(cell: &mut Cell, problem: &Problem, widths: &[f64]) {
+    for (i, &total) in widths.iter().enumerate() {
         let w = cell.hi[i] - cell.lo[i];
         if w <= 0.0 || total <= 0.0 {
             continue;

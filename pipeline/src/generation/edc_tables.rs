@@ -8,7 +8,7 @@
 //! a witness proves possibility wherever it is.
 
 use crate::calculus::{CompositionEntry, CompositionFile, EntryKind, RelationSet, UnaryFile};
-use crate::edc::{classify, fixed_point, free_point, mirror, region_constraints, REGIONS, SIGNS};
+use crate::edc::{classify, fixed_point, free_point, is_left, mirror, region_constraints, REGIONS};
 use crate::feasibility::{BranchAndBound, Linear, Outcome, Problem, Quadratic, Settings};
 use crate::geometry::{Point, Point2};
 use rand::{Rng, SeedableRng};
@@ -88,6 +88,17 @@ pub struct CompositionReport {
     pub slowest_cells: Vec<((u8, u8), f64)>,
 }
 
+impl CompositionReport {
+    /// Adds another run's counts (not its cell timings).
+    fn add(&mut self, other: &CompositionReport) {
+        self.sampled += other.sampled;
+        self.searched_feasible += other.searched_feasible;
+        self.proved_infeasible += other.proved_infeasible;
+        self.undecided += other.undecided;
+        self.boxes += other.boxes;
+    }
+}
+
 /// Decides one cell: every `AB:D` compatible with `AB:C = ab_c`, `BC:D = bc_d`. Cells with C
 /// right of AB are the mirror images of cells with C left of it (reflection across AB swaps
 /// left and right in every frame), so only the left half is searched.
@@ -96,7 +107,7 @@ pub fn edc_composition_cell(
     bc_d: u8,
     settings: &Settings,
 ) -> (Vec<CompositionEntry>, CompositionReport) {
-    if SIGNS[ab_c as usize - 1][0] > 0 {
+    if is_left(ab_c) {
         return search_cell(ab_c, bc_d, settings);
     }
     let (entries, report) = search_cell(mirror(ab_c), mirror(bc_d), settings);
@@ -267,7 +278,7 @@ pub fn edc_composition(
 ) -> (CompositionFile, CompositionReport) {
     // Search the left half in parallel, then fill every cell (mirroring the right half).
     let left: Vec<(u8, u8)> = (1..=REGIONS)
-        .filter(|&r1| SIGNS[r1 as usize - 1][0] > 0)
+        .filter(|&r1| is_left(r1))
         .flat_map(|r1| (1..=REGIONS).map(move |r2| (r1, r2)))
         .collect();
     type Searched = ((u8, u8), (Vec<CompositionEntry>, CompositionReport), f64);
@@ -285,11 +296,7 @@ pub fn edc_composition(
     let mut by_cell = std::collections::HashMap::new();
     for (cell, (e, r), seconds) in searched {
         total.slowest_cells.push((cell, seconds));
-        total.sampled += r.sampled;
-        total.searched_feasible += r.searched_feasible;
-        total.proved_infeasible += r.proved_infeasible;
-        total.undecided += r.undecided;
-        total.boxes += r.boxes;
+        total.add(&r);
         by_cell.insert(cell, e);
     }
     total.slowest_cells.sort_by(|a, b| b.1.total_cmp(&a.1));
@@ -322,7 +329,7 @@ pub fn edc_unary(settings: &Settings) -> (UnaryFile, usize) {
     let engine = BranchAndBound::new(settings.clone());
     let (lower, upper) = search_box(n);
     let mut undecided = 0;
-    let mut solve_for = |r: u8, target: &dyn Fn(u8) -> Vec<crate::feasibility::Quadratic>| {
+    let mut solve_for = |r: u8, target: &dyn Fn(u8) -> Vec<Quadratic>| {
         let problem = Problem {
             lower: lower.clone(),
             upper: upper.clone(),
