@@ -30,4 +30,19 @@ pub trait Calculus: Send + Sync + 'static {
     fn universe() -> RelationSet {
         RelationSet::all(Self::RELATIONS as usize)
     }
+
+    /// The relations of this calculus possible for an arrangement measured to lie in one of the
+    /// EDC `regions`. Measurement (000 §IV) decides EDC regions, the finest open cells of the
+    /// boundaries of both calculi; a calculus whose relations include zero-area ones (lines)
+    /// must add those bordering a possible cell, since a feasible set of arrangements that
+    /// touches a line also reaches a cell beside it.
+    fn from_edc(regions: RelationSet) -> RelationSet;
+
+    /// The EDC regions a measurement must test when `open` relations are still possible.
+    fn edc_candidates(open: RelationSet) -> RelationSet {
+        RelationSet::from_relations(
+            (1..=crate::edc::REGIONS)
+                .filter(|&r| !Self::from_edc(RelationSet::single(r)).intersection(open).is_empty()),
+        )
+    }
 }

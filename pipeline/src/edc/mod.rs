@@ -10,7 +10,7 @@ pub use region::{
     classify, defining_boundaries, is_left, mirror, region_of_signs, LUNE, REGIONS, SIGNS,
 };
 
-use crate::calculus::{Calculus, CompositionFile, OperatorTables, UnaryFile};
+use crate::calculus::{Calculus, CompositionFile, OperatorTables, RelationSet, UnaryFile};
 use crate::geometry::Point;
 use std::sync::OnceLock;
 
@@ -28,6 +28,10 @@ impl Calculus for Edc {
 
     fn classify(a: Point, b: Point, c: Point) -> Option<u8> {
         classify(a, b, c)
+    }
+
+    fn from_edc(regions: RelationSet) -> RelationSet {
+        regions
     }
 
     fn tables() -> &'static OperatorTables {

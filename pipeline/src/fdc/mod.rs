@@ -79,6 +79,33 @@ impl Calculus for Fdc {
         classify_generic(&a, &b, &c)
     }
 
+    /// Each EDC region lies in one two-dimensional FDC cell (left or right × front of B, between,
+    /// behind A); the lines bordering a possible cell are possible too (see the trait). The
+    /// points A and B (5, 11) never are, for distinct landmarks.
+    fn from_edc(regions: RelationSet) -> RelationSet {
+        let mut out = RelationSet::EMPTY;
+        for region in regions.iter() {
+            let signs = crate::edc::SIGNS[region as usize - 1];
+            let row = if signs[2] > 0 {
+                0
+            } else if signs[1] > 0 {
+                2
+            } else {
+                4
+            };
+            let column = if signs[0] > 0 { 0 } else { 2 };
+            let cell = |row: u8, column: u8| row * 3 + column + 1;
+            out = out.with(cell(row, column)).with(cell(row, 1));
+            if row > 0 {
+                out = out.with(cell(row - 1, column));
+            }
+            if row < 4 {
+                out = out.with(cell(row + 1, column));
+            }
+        }
+        out.intersection(Self::universe())
+    }
+
     /// Distinct landmarks never coincide: relations 5 (C = B) and 11 (C = A) are excluded.
     fn universe() -> RelationSet {
         RelationSet::all(RELATIONS as usize).without(5).without(11)

@@ -1,0 +1,141 @@
+//! Measuring qualitative states from one panorama (000 §IV): bearings of the visible landmarks
+//! and a range ordering give, for every triple, the relations consistent with the observation.
+//!
+//! Beyond the paper, for real sensors: the range order may be partial ([`RangeOrder`]), and each
+//! bearing may carry an uncertainty interval. Every result is sound: an arrangement whose
+//! bearings lie within their intervals and whose ranges respect the order is never excluded
+//! (up to the feasibility engine's documented margin).
+
+mod range_order;
+mod triple;
+
+pub use range_order::{RangeOrder, RangeOrderError};
+pub use triple::{measure_triple_edc, TripleRelations};
+
+use crate::calculus::{Calculus, RelationSet};
+use crate::feasibility::BranchAndBound;
+use rayon::prelude::*;
+use std::f64::consts::FRAC_PI_4;
+use thiserror::Error;
+
+/// Largest accepted half-width of a bearing interval. Sectors must stay well inside a half
+/// plane for the formulation's `|t| ≤ s·tan δ`; 45° is far beyond any camera's error.
+pub const MAX_BEARING_UNCERTAINTY: f64 = FRAC_PI_4;
+
+/// The direction to a landmark in the camera frame (radians, counter-clockwise; any zero),
+/// known to within `± uncertainty`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bearing {
+    pub angle: f64,
+    pub uncertainty: f64,
+}
+
+impl Bearing {
+    pub fn exact(angle: f64) -> Bearing {
+        Bearing {
+            angle,
+            uncertainty: 0.0,
+        }
+    }
+}
+
+/// What one panorama tells about the landmarks it shows: bearings (000 §IV assumption 1) and
+/// the range ordering (assumption 2), indexed by position in `bearings`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Panorama {
+    pub bearings: Vec<Bearing>,
+    pub order: RangeOrder,
+}
+
+/// An observation that cannot be measured.
+#[derive(Debug, Error, PartialEq)]
+pub enum MeasurementError {
+    #[error("bearing of landmark {index} is not a finite angle ({angle})")]
+    BearingNotFinite { index: usize, angle: f64 },
+    #[error(
+        "bearing uncertainty of landmark {index} is {value} rad; it must lie in [0, {max}) rad"
+    )]
+    BadUncertainty { index: usize, value: f64, max: f64 },
+    #[error("the range order covers {order} landmarks but the panorama has {bearings} bearings")]
+    OrderSize { order: usize, bearings: usize },
+}
+
+impl Panorama {
+    pub fn new(bearings: Vec<Bearing>, order: RangeOrder) -> Result<Panorama, MeasurementError> {
+        for (index, b) in bearings.iter().enumerate() {
+            if !b.angle.is_finite() {
+                return Err(MeasurementError::BearingNotFinite {
+                    index,
+                    angle: b.angle,
+                });
+            }
+            if !(0.0..MAX_BEARING_UNCERTAINTY).contains(&b.uncertainty) {
+                return Err(MeasurementError::BadUncertainty {
+                    index,
+                    value: b.uncertainty,
+                    max: MAX_BEARING_UNCERTAINTY,
+                });
+            }
+        }
+        if order.len() != bearings.len() {
+            return Err(MeasurementError::OrderSize {
+                order: order.len(),
+                bearings: bearings.len(),
+            });
+        }
+        Ok(Panorama { bearings, order })
+    }
+
+    pub fn len(&self) -> usize {
+        self.bearings.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.bearings.is_empty()
+    }
+
+    /// The relations `AB:C`, `BC:A`, `CA:B` of calculus `C` for landmarks `[a, b, c]` of this
+    /// panorama, restricted to `open` (e.g. what the map still allows).
+    pub fn measure_triple<C: Calculus>(
+        &self,
+        landmarks: [usize; 3],
+        open: TripleRelations,
+        engine: &BranchAndBound,
+    ) -> TripleRelations {
+        let bearings = landmarks.map(|i| self.bearings[i]);
+        let nearer = self.order.restricted(&landmarks);
+        match measure_triple_edc(bearings, &nearer, open.map(C::edc_candidates), engine) {
+            Some(regions) => std::array::from_fn(|k| C::from_edc(regions[k]).intersection(open[k])),
+            None => open,
+        }
+    }
+
+    /// Every triple `i < j < k` of the panorama, measured in parallel; `open` gives the
+    /// relations still possible for a triple (all of the calculus' universe for a fresh map).
+    pub fn measure_all<C, F>(&self, open: F, engine: &BranchAndBound) -> Vec<TripleMeasurement>
+    where
+        C: Calculus,
+        F: Fn([usize; 3]) -> TripleRelations + Sync,
+    {
+        let n = self.len();
+        let triples: Vec<[usize; 3]> = (0..n)
+            .flat_map(|i| (i + 1..n).flat_map(move |j| (j + 1..n).map(move |k| [i, j, k])))
+            .collect();
+        triples
+            .into_par_iter()
+            .map(|landmarks| TripleMeasurement {
+                landmarks,
+                states: self.measure_triple::<C>(landmarks, open(landmarks), engine),
+            })
+            .collect()
+    }
+}
+
+/// The measured relations of one triple of a panorama's landmarks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TripleMeasurement {
+    /// Positions `[a, b, c]` in the panorama.
+    pub landmarks: [usize; 3],
+    /// `[AB:C, BC:A, CA:B]`.
+    pub states: [RelationSet; 3],
+}
