@@ -8,3 +8,4 @@ pub mod fdc;
 pub mod feasibility;
 pub mod generation;
 pub mod geometry;
+pub mod map;
