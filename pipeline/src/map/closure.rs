@@ -36,6 +36,9 @@ const PERMUTATIONS: [[usize; 3]; 6] = [
     [2, 1, 0],
 ];
 
+/// A narrowed edge: its rank and the relations to intersect in.
+type Revision = (usize, [u32; 3]);
+
 /// Runs the closure until the worklist is empty. On a contradiction returns the edge rank and
 /// slot of the relation that would become empty.
 pub(super) fn close<C: Calculus>(tx: &mut Transaction<'_, C>) -> Result<(), (usize, usize)> {
@@ -49,7 +52,7 @@ pub(super) fn close<C: Calculus>(tx: &mut Transaction<'_, C>) -> Result<(), (usi
             let kernel = tx.kernel;
             let edges = &tx.map.edges;
             let in_round = &in_round;
-            let revisions: Vec<(Vec<(usize, [u32; 3])>, u64)> = batch
+            let revisions: Vec<(Vec<Revision>, u64)> = batch
                 .par_chunks(TASK)
                 .map(|task| {
                     let mut out = Vec::new();
@@ -74,21 +77,119 @@ pub(super) fn close<C: Calculus>(tx: &mut Transaction<'_, C>) -> Result<(), (usi
     Ok(())
 }
 
-/// The six ordered relations of an edge over four positions: `m[a][b]` is `p_a p_b : p_c`
-/// for the third position `c` of the edge.
-type Ordered = [[u32; 4]; 4];
+/// The four ordered relations of an edge `{x, y, W}` (`x < y` positions of the queued edge)
+/// that the compositions read and narrow: `[xy:W, yx:W, Wx:y, Wy:x]`.
+type Around = [u32; 4];
+const XY_W: usize = 0;
+const YX_W: usize = 1;
+const WX_Y: usize = 2;
+const WY_X: usize = 3;
 
-/// Fills `m` with the ordered relations of the edge with stored relations `s`, whose positions
-/// in increasing internal index are `q`.
-#[inline]
-fn load(kernel: &Kernel, s: [u32; 3], [q0, q1, q2]: [usize; 3], m: &mut Ordered) {
-    m[q0][q1] = s[0];
-    m[q1][q2] = s[1];
-    m[q2][q0] = s[2];
-    m[q1][q0] = kernel.inverse(s[0]);
-    m[q2][q1] = kernel.inverse(s[1]);
-    m[q0][q2] = kernel.inverse(s[2]);
+/// Where W lies among the edge's landmarks `x < y` in internal index order; fixes which
+/// stored slot holds which ordered relation.
+#[derive(Clone, Copy)]
+enum Place {
+    /// Stored as `(W, x, y)`: `[Wx:y, xy:W, yW:x]`.
+    Before,
+    /// Stored as `(x, W, y)`: `[xW:y, Wy:x, yx:W]`.
+    Between,
+    /// Stored as `(x, y, W)`: `[xy:W, yW:x, Wx:y]`.
+    After,
 }
+
+fn around(kernel: &Kernel, s: [u32; 3], place: Place) -> Around {
+    match place {
+        Place::Before => [s[1], kernel.inverse(s[1]), s[0], kernel.inverse(s[2])],
+        Place::Between => [kernel.inverse(s[2]), s[2], kernel.inverse(s[0]), s[1]],
+        Place::After => [s[0], kernel.inverse(s[0]), s[2], kernel.inverse(s[1])],
+    }
+}
+
+/// The stored relations after narrowing the ordered ones to `v` (INVERSE is one-to-one, so
+/// intersecting both orderings of a pair loses nothing).
+fn stored(kernel: &Kernel, s: [u32; 3], v: Around, place: Place) -> [u32; 3] {
+    let inv = |x| kernel.inverse(x);
+    match place {
+        Place::Before => [s[0] & v[WX_Y], v[XY_W] & inv(v[YX_W]), s[2] & inv(v[WY_X])],
+        Place::Between => [s[0] & inv(v[WX_Y]), s[1] & v[WY_X], v[YX_W] & inv(v[XY_W])],
+        Place::After => [v[XY_W] & inv(v[YX_W]), s[1] & inv(v[WY_X]), s[2] & v[WX_Y]],
+    }
+}
+
+/// One composition of a 4-set `{0, 1, 2, W}` (positions 0 < 1 < 2 of the queued edge):
+/// `out ⊆ COMPOSE(first, second)`, where one input is an ordered relation of the queued edge
+/// (`edge_pair`) and the other and the output are ordered relations of edges containing W
+/// (edge `e` is the one without position `e`).
+struct Step {
+    edge_pair: (usize, usize),
+    /// The W-edge input `(e, which)`.
+    input: (usize, usize),
+    /// The W-edge output `(e, which)`.
+    output: (usize, usize),
+}
+
+/// Index into [`Around`] of `pq:W` for positions `p != q` of the queued edge.
+const fn pair_w(p: usize, q: usize) -> usize {
+    if p < q {
+        XY_W
+    } else {
+        YX_W
+    }
+}
+
+/// Index into [`Around`] of `Wp:q`.
+const fn w_pair(p: usize, q: usize) -> usize {
+    if p < q {
+        WX_Y
+    } else {
+        WY_X
+    }
+}
+
+/// The queued edge as first input: `AB:W ⊆ COMPOSE(AB:C, BC:W)` for its orderings `(A,B,C)`.
+const FIRST: [Step; 6] = {
+    let mut steps = [const {
+        Step {
+            edge_pair: (0, 0),
+            input: (0, 0),
+            output: (0, 0),
+        }
+    }; 6];
+    let mut n = 0;
+    while n < 6 {
+        let [a, b, c] = PERMUTATIONS[n];
+        steps[n] = Step {
+            edge_pair: (a, b),
+            input: (a, pair_w(b, c)),
+            output: (c, pair_w(a, b)),
+        };
+        n += 1;
+    }
+    steps
+};
+
+/// The queued edge as second input: `WB:D ⊆ COMPOSE(WB:C, BC:D)` for its orderings `(B,C,D)`;
+/// `input.0` is the edge `{W, B, C}` (without `D`).
+const SECOND: [Step; 6] = {
+    let mut steps = [const {
+        Step {
+            edge_pair: (0, 0),
+            input: (0, 0),
+            output: (0, 0),
+        }
+    }; 6];
+    let mut n = 0;
+    while n < 6 {
+        let [b, c, d] = PERMUTATIONS[n];
+        steps[n] = Step {
+            edge_pair: (b, c),
+            input: (d, w_pair(b, c)),
+            output: (c, w_pair(b, d)),
+        };
+        n += 1;
+    }
+    steps
+};
 
 /// Revises every composition of the 4-sets containing queued edge `t` in which `t` is an
 /// input; appends the narrowed edges to `out` and returns the number of compositions.
@@ -98,92 +199,84 @@ fn revise(
     edges: &[[u32; 3]],
     in_round: &BitSet,
     t: usize,
-    out: &mut Vec<(usize, [u32; 3])>,
+    out: &mut Vec<Revision>,
 ) -> u64 {
     let u = kernel.universe;
     let skip_universe = kernel.universe_neutral;
     let unconstrained = |s: u32| skip_universe && s == u;
-    // Positions 0, 1, 2 are the edge's landmarks i < j < k, position 3 is W.
-    let p3 = unrank(t);
-    let mut tri: Ordered = [[0; 4]; 4];
-    load(kernel, edges[t], [0, 1, 2], &mut tri);
+    let p = unrank(t);
+    // Ordered relations of the queued edge: tri[a][b] = p_a p_b : p_c.
+    let s = edges[t];
+    let mut tri = [[0u32; 3]; 3];
+    tri[0][1] = s[0];
+    tri[1][2] = s[1];
+    tri[2][0] = s[2];
+    tri[1][0] = kernel.inverse(s[0]);
+    tri[2][1] = kernel.inverse(s[1]);
+    tri[0][2] = kernel.inverse(s[2]);
+    // The W-edge without position e holds positions OTHERS[e] (in increasing order) and W.
+    const OTHERS: [(usize, usize); 3] = [(1, 2), (0, 2), (0, 1)];
     let mut count = 0;
     for w in 0..n {
-        if p3.contains(&w) {
+        if p.contains(&w) {
             continue;
         }
-        // Edge e (0..3) is the one without position e: positions `others[e]` and W.
         let mut ranks = [0usize; 3];
-        let mut orders = [[0usize; 3]; 3];
-        let mut stored = [[0u32; 3]; 3];
+        let mut places = [Place::After; 3];
+        let mut old = [[0u32; 3]; 3];
         for e in 0..3 {
-            let (x, y) = match e {
-                0 => (1, 2),
-                1 => (0, 2),
-                _ => (0, 1),
-            };
-            let (px, py) = (p3[x], p3[y]);
-            let (r, q) = if w < px {
-                (rank(w, px, py), [3, x, y])
+            let (x, y) = OTHERS[e];
+            let (px, py) = (p[x], p[y]);
+            (ranks[e], places[e]) = if w < px {
+                (rank(w, px, py), Place::Before)
             } else if w < py {
-                (rank(px, w, py), [x, 3, y])
+                (rank(px, w, py), Place::Between)
             } else {
-                (rank(px, py, w), [x, y, 3])
+                (rank(px, py, w), Place::After)
             };
-            ranks[e] = r;
-            orders[e] = q;
-            stored[e] = edges[r];
+            old[e] = edges[ranks[e]];
         }
-        if skip_universe && stored.iter().all(|s| s.iter().all(|&x| x == u)) {
+        if skip_universe && old.iter().all(|s| *s == [u; 3]) {
             continue;
         }
-        let mut m: [Ordered; 3] = [[[0; 4]; 4]; 3];
-        for e in 0..3 {
-            load(kernel, stored[e], orders[e], &mut m[e]);
-        }
+        let mut v: [Around; 3] = [
+            around(kernel, old[0], places[0]),
+            around(kernel, old[1], places[1]),
+            around(kernel, old[2], places[2]),
+        ];
         let mut dirty = [false; 3];
-        // As first input: AB:W ⊆ COMPOSE(AB:C, BC:W) for the orderings (A, B, C) of the edge.
-        for [a, b, c] in PERMUTATIONS {
-            let (ab_c, bc_w) = (tri[a][b], m[a][b][c]);
-            if unconstrained(ab_c) || unconstrained(bc_w) {
-                continue;
+        let mut apply = |v: &mut [Around; 3], step: &Step, first: u32, second: u32| {
+            if unconstrained(first) || unconstrained(second) {
+                return;
             }
             count += 1;
-            let ab_w = m[c][a][b];
-            let narrowed = kernel.compose_within(ab_c, bc_w, ab_w);
-            if narrowed != ab_w {
-                m[c][a][b] = narrowed;
-                dirty[c] = true;
+            let (oe, ok) = step.output;
+            let narrowed = kernel.compose_within(first, second, v[oe][ok]);
+            if narrowed != v[oe][ok] {
+                v[oe][ok] = narrowed;
+                dirty[oe] = true;
             }
+        };
+        for step in &FIRST {
+            let (a, b) = step.edge_pair;
+            let (ie, ik) = step.input;
+            let bc_w = v[ie][ik];
+            apply(&mut v, step, tri[a][b], bc_w);
         }
-        // As second input: WB:D ⊆ COMPOSE(WB:C, BC:D) for the orderings (B, C, D) of the edge,
-        // unless the first input {W, B, C} is queued in this round itself.
-        for [b, c, d] in PERMUTATIONS {
-            if in_round.contains(ranks[d]) {
+        for step in &SECOND {
+            let (ie, ik) = step.input;
+            // Evaluated from the first input's own revision when that edge is queued too.
+            if in_round.contains(ranks[ie]) {
                 continue;
             }
-            let (wb_c, bc_d) = (m[d][3][b], tri[b][c]);
-            if unconstrained(wb_c) || unconstrained(bc_d) {
-                continue;
-            }
-            count += 1;
-            let wb_d = m[c][3][b];
-            let narrowed = kernel.compose_within(wb_c, bc_d, wb_d);
-            if narrowed != wb_d {
-                m[c][3][b] = narrowed;
-                dirty[c] = true;
-            }
+            let (b, c) = step.edge_pair;
+            let wb_c = v[ie][ik];
+            apply(&mut v, step, wb_c, tri[b][c]);
         }
         for e in 0..3 {
             if dirty[e] {
-                let [q0, q1, q2] = orders[e];
-                let me = &m[e];
-                let new = [
-                    me[q0][q1] & kernel.inverse(me[q1][q0]),
-                    me[q1][q2] & kernel.inverse(me[q2][q1]),
-                    me[q2][q0] & kernel.inverse(me[q0][q2]),
-                ];
-                if new != stored[e] {
+                let new = stored(kernel, old[e], v[e], places[e]);
+                if new != old[e] {
                     out.push((ranks[e], new));
                 }
             }

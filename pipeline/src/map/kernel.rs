@@ -15,6 +15,8 @@ const CHUNK_CELLS: usize = 1 << CHUNK_BITS;
 #[derive(Debug)]
 struct ChunkTable {
     chunks: usize,
+    /// `single[r − 1]`: image of relation `r` alone (the common case in a tight map).
+    single: Vec<u32>,
     /// `cells[c · 128 + m]` = union of the images of relations `7c + t + 1` for bits `t` of `m`.
     cells: Vec<u32>,
 }
@@ -33,11 +35,18 @@ impl ChunkTable {
                 cells[c * CHUNK_CELLS + m] = cells[c * CHUNK_CELLS + rest] | own;
             }
         }
-        ChunkTable { chunks, cells }
+        ChunkTable {
+            chunks,
+            single: image.to_vec(),
+            cells,
+        }
     }
 
     #[inline]
     fn apply(&self, set: u32) -> u32 {
+        if set.is_power_of_two() {
+            return self.single[set.trailing_zeros() as usize];
+        }
         let mut out = 0;
         for c in 0..self.chunks {
             let m = (set >> (c * CHUNK_BITS)) as usize & (CHUNK_CELLS - 1);
