@@ -144,12 +144,11 @@ impl<C: Calculus> PartialEq for Hypergraph<C> {
             return false;
         }
         let to_other: Vec<usize> = self.landmarks.iter().map(|id| other.index[id]).collect();
+        let kernel = Kernel::of::<C>();
         self.triples_internal().all(|([i, j, k], rel)| {
             let (a, b, c) = (to_other[i], to_other[j], to_other[k]);
-            let loc = locate(a, b, c);
-            // Relations of (a,b,c) in other's storage: slot order follows (a,b,c) cyclically
-            // when the ordering is cyclic, else the INVERSE images.
-            let kernel = Kernel::of::<C>();
+            // The same ordered relations read from other's storage (INVERSE where other
+            // stores the anti-cyclic ordering).
             let theirs = |x: usize, y: usize, z: usize| {
                 let l = locate(x, y, z);
                 let s = other.edges[l.rank][l.slot];
@@ -159,8 +158,7 @@ impl<C: Calculus> PartialEq for Hypergraph<C> {
                     s
                 }
             };
-            loc.rank < other.edges.len()
-                && rel == [theirs(a, b, c), theirs(b, c, a), theirs(c, a, b)]
+            rel == [theirs(a, b, c), theirs(b, c, a), theirs(c, a, b)]
         })
     }
 }
