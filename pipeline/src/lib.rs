@@ -9,3 +9,4 @@ pub mod feasibility;
 pub mod generation;
 pub mod geometry;
 pub mod measurement;
+pub mod map;

@@ -1,12 +1,19 @@
 //! Benchmarks of the calculus core (figures in docs/BENCHMARKS.md):
 //! - median time of one 2-unknown feasibility decision (all 3 × 20 × 20 EDC unary problems),
 //! - median time of one 4-unknown decision (a deterministic sample of composition triples),
-//! - wall time to regenerate each table.
+//! - wall time to regenerate each table;
+//! - with `--closure`: path-consistency closure of complete random maps (000 §VI-B).
 
 use clap::Parser;
+use qrm::calculus::{Calculus, RelationSet};
+use qrm::edc::Edc;
 use qrm::edc::{fixed_point, free_point, region_constraints};
+use qrm::fdc::Fdc;
 use qrm::feasibility::{BranchAndBound, Outcome, Quadratic};
 use qrm::generation::{edc_composition, edc_unary, fdc_composition, fdc_unary};
+use qrm::geometry::Point;
+use qrm::map::{Hypergraph, Observation};
+use rand::{Rng, SeedableRng};
 use std::time::Instant;
 
 #[derive(Parser, Debug)]
@@ -18,6 +25,76 @@ struct Args {
     /// Only time the EDC composition cells `R1 R2` (repeatable), with their search counts.
     #[arg(long, num_args = 2, value_names = ["AB_C", "BC_D"], value_parser = clap::value_parser!(u8).range(1..=20))]
     cell: Vec<u8>,
+    /// Time the map closure instead: complete random networks of these sizes (repeatable).
+    #[arg(long, num_args = 1.., value_name = "N")]
+    closure: Vec<usize>,
+    /// Random extra states added to the true state of every relation (with `--closure`).
+    #[arg(long, default_value_t = 3)]
+    extra: usize,
+}
+
+/// Fuses a complete random network of `n` landmarks in one update: every relation of every
+/// triple is its true state plus `extra` random other states. Prints wall time, compositions,
+/// rounds, map heap bytes and process peak RSS.
+fn bench_closure<C: Calculus>(n: usize, extra: usize) {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(n as u64);
+    let points: Vec<Point> = (0..n)
+        .map(|_| {
+            Point::new(
+                rng.random_range(-100.0..100.0),
+                rng.random_range(-100.0..100.0),
+            )
+        })
+        .collect();
+    let universe: Vec<u8> = C::universe().iter().collect();
+    let mut observations = Vec::new();
+    for k in 2..n {
+        for j in 1..k {
+            for i in 0..j {
+                for [a, b, c] in [[i, j, k], [j, k, i], [k, i, j]] {
+                    let Some(truth) = C::classify(points[a], points[b], points[c]) else {
+                        continue;
+                    };
+                    let mut states = RelationSet::single(truth);
+                    while states.len() < (extra + 1).min(universe.len()) {
+                        states = states.with(universe[rng.random_range(0..universe.len())]);
+                    }
+                    observations.push(Observation::new(a as u32, b as u32, c as u32, states));
+                }
+            }
+        }
+    }
+    let mut map = Hypergraph::<C>::new();
+    let start = Instant::now();
+    let report = map.fuse(&observations).expect("true states are consistent");
+    let elapsed = start.elapsed().as_secs_f64();
+    let mean: f64 = map
+        .triples()
+        .map(|(_, _, _, r)| r.iter().map(|s| s.len()).sum::<usize>() as f64)
+        .sum::<f64>()
+        / (3 * map.triple_count()).max(1) as f64;
+    println!(
+        "{} n={n:>3}: {:>9.3} ms, {:>11} compositions, {:>2} rounds, {:>9} relations tightened, mean |relation| {mean:.2}, map {:>6.1} MB, peak RSS {:>6.1} MB",
+        C::NAME,
+        elapsed * 1e3,
+        report.compositions,
+        report.rounds,
+        report.relations_tightened,
+        map.heap_bytes() as f64 / 1e6,
+        peak_rss_kib() as f64 / 1024.0,
+    );
+}
+
+/// `VmHWM` of this process in KiB (0 where /proc is unavailable).
+fn peak_rss_kib() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse().ok())
+        })
+        .unwrap_or(0)
 }
 
 /// Median and 90th percentile in microseconds, with the outcome counts.
@@ -41,6 +118,13 @@ fn time_decisions(problems: &[(Vec<f64>, Vec<f64>, Vec<Quadratic>)]) -> (f64, f6
 
 fn main() {
     let args = Args::parse();
+    if !args.closure.is_empty() {
+        for &n in &args.closure {
+            bench_closure::<Edc>(n, args.extra);
+            bench_closure::<Fdc>(n, args.extra);
+        }
+        return;
+    }
     if !args.cell.is_empty() {
         for pair in args.cell.chunks(2) {
             let start = Instant::now();

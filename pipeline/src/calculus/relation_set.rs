@@ -20,6 +20,17 @@ impl RelationSet {
         }
     }
 
+    /// The raw bitset: bit `r - 1` set when relation `r` is possible. Used by the map's
+    /// table-driven set operations (000 §III-C applied to whole sets at once).
+    pub const fn bits(self) -> u32 {
+        self.0
+    }
+
+    /// The set whose bit `r - 1` is set exactly for the members `r`; inverse of [`Self::bits`].
+    pub const fn from_bits(bits: u32) -> RelationSet {
+        RelationSet(bits)
+    }
+
     /// The singleton `{r}`; `r` is 1-based as in the papers.
     pub const fn single(r: u8) -> RelationSet {
         RelationSet(1u32 << (r - 1))

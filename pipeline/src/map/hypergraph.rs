@@ -1,0 +1,239 @@
+//! The qualitative map `M = (P, E)` of 000 §VI-A: landmarks and one edge per unordered triple
+//! storing `{p_i p_j : p_k, p_j p_k : p_i, p_k p_i : p_j}`.
+
+use super::index::{choose3, locate, rank};
+use super::kernel::Kernel;
+use super::update::LandmarkId;
+use crate::calculus::{Calculus, RelationSet};
+use std::collections::HashMap;
+use std::fmt;
+use std::marker::PhantomData;
+
+/// A 3-uniform hypergraph over landmarks with relation sets of calculus `C` on every edge,
+/// kept path consistent by [`Hypergraph::fuse`] and [`Hypergraph::merge`].
+///
+/// Storage is dense: the edge of internal indices `i < j < k` (insertion order of the
+/// landmarks) lives at `C(k,3) + C(j,2) + i` in one flat vector and holds the raw bitsets of
+/// `[ij:k, jk:i, ki:j]` (12 bytes per edge; 300 landmarks ≈ 4.5 M edges ≈ 53 MB). Edges of a
+/// new landmark are appended and start at `C::universe()`.
+pub struct Hypergraph<C: Calculus> {
+    pub(super) landmarks: Vec<LandmarkId>,
+    pub(super) index: HashMap<LandmarkId, usize>,
+    pub(super) edges: Vec<[u32; 3]>,
+    calculus: PhantomData<fn() -> C>,
+}
+
+impl<C: Calculus> Hypergraph<C> {
+    /// The empty map.
+    pub fn new() -> Hypergraph<C> {
+        Hypergraph {
+            landmarks: Vec::new(),
+            index: HashMap::new(),
+            edges: Vec::new(),
+            calculus: PhantomData,
+        }
+    }
+
+    /// Landmarks in insertion order.
+    pub fn landmarks(&self) -> &[LandmarkId] {
+        &self.landmarks
+    }
+
+    /// Number of landmarks.
+    pub fn len(&self) -> usize {
+        self.landmarks.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.landmarks.is_empty()
+    }
+
+    pub fn contains(&self, id: LandmarkId) -> bool {
+        self.index.contains_key(&id)
+    }
+
+    /// Number of edges, `C(len, 3)`.
+    pub fn triple_count(&self) -> usize {
+        self.edges.len()
+    }
+
+    /// Heap bytes held by the map (edges, landmark list and id index).
+    pub fn heap_bytes(&self) -> usize {
+        self.edges.capacity() * std::mem::size_of::<[u32; 3]>()
+            + self.landmarks.capacity() * std::mem::size_of::<LandmarkId>()
+            + self.index.capacity()
+                * (std::mem::size_of::<(LandmarkId, usize)>() + std::mem::size_of::<u64>())
+    }
+
+    /// The stored estimate of `AB:C` for landmarks `a`, `b`, `c` in this order, derived with
+    /// INVERSE when the ordering is anti-cyclic with respect to the stored edge (000 §VI-B
+    /// step 3). `None` for an unknown id or ids that are not distinct.
+    pub fn relation(&self, a: LandmarkId, b: LandmarkId, c: LandmarkId) -> Option<RelationSet> {
+        let (ia, ib, ic) = (
+            *self.index.get(&a)?,
+            *self.index.get(&b)?,
+            *self.index.get(&c)?,
+        );
+        if ia == ib || ib == ic || ia == ic {
+            return None;
+        }
+        let loc = locate(ia, ib, ic);
+        let stored = self.edges[loc.rank][loc.slot];
+        Some(RelationSet::from_bits(if loc.inverted {
+            Kernel::of::<C>().inverse(stored)
+        } else {
+            stored
+        }))
+    }
+
+    /// Every edge once, in storage order, as landmark ids `(a, b, c)` (insertion order
+    /// `a` before `b` before `c`) with the relations `[AB:C, BC:A, CA:B]`.
+    pub fn triples(&self) -> Triples<'_> {
+        Triples {
+            landmarks: &self.landmarks,
+            edges: &self.edges,
+            next: 0,
+            ijk: [0, 1, 2],
+        }
+    }
+
+    /// Appends a landmark and its edges at the universe; returns its internal index.
+    pub(super) fn push_landmark(&mut self, id: LandmarkId) -> usize {
+        let k = self.landmarks.len();
+        self.landmarks.push(id);
+        self.index.insert(id, k);
+        let universe = C::universe().bits();
+        self.edges.resize(choose3(k + 1), [universe; 3]);
+        k
+    }
+
+    /// Drops the landmarks from `count` on, with their edges.
+    pub(super) fn truncate_landmarks(&mut self, count: usize) {
+        for id in self.landmarks.drain(count..) {
+            self.index.remove(&id);
+        }
+        self.edges.truncate(choose3(count));
+    }
+}
+
+impl<C: Calculus> Default for Hypergraph<C> {
+    fn default() -> Self {
+        Hypergraph::new()
+    }
+}
+
+impl<C: Calculus> Clone for Hypergraph<C> {
+    fn clone(&self) -> Self {
+        Hypergraph {
+            landmarks: self.landmarks.clone(),
+            index: self.index.clone(),
+            edges: self.edges.clone(),
+            calculus: PhantomData,
+        }
+    }
+}
+
+/// Two maps are equal when they know the same landmarks and agree on every relation; the
+/// insertion order of the landmarks (internal indexing) is not compared.
+impl<C: Calculus> PartialEq for Hypergraph<C> {
+    fn eq(&self, other: &Self) -> bool {
+        if self.landmarks == other.landmarks {
+            return self.edges == other.edges;
+        }
+        if self.len() != other.len() || !self.landmarks.iter().all(|id| other.contains(*id)) {
+            return false;
+        }
+        let to_other: Vec<usize> = self.landmarks.iter().map(|id| other.index[id]).collect();
+        let kernel = Kernel::of::<C>();
+        self.triples_internal().all(|([i, j, k], rel)| {
+            let (a, b, c) = (to_other[i], to_other[j], to_other[k]);
+            // The same ordered relations read from other's storage (INVERSE where other
+            // stores the anti-cyclic ordering).
+            let theirs = |x: usize, y: usize, z: usize| {
+                let l = locate(x, y, z);
+                let s = other.edges[l.rank][l.slot];
+                if l.inverted {
+                    kernel.inverse(s)
+                } else {
+                    s
+                }
+            };
+            rel == [theirs(a, b, c), theirs(b, c, a), theirs(c, a, b)]
+        })
+    }
+}
+
+impl<C: Calculus> Eq for Hypergraph<C> {}
+
+/// Lists the landmarks and the edges that are not entirely unconstrained.
+impl<C: Calculus> fmt::Debug for Hypergraph<C> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let universe = C::universe();
+        let constrained: Vec<String> = self
+            .triples()
+            .filter(|(_, _, _, r)| r.iter().any(|s| *s != universe))
+            .map(|(a, b, c, [x, y, z])| format!("({a},{b},{c}): {x} {y} {z}"))
+            .collect();
+        f.debug_struct("Hypergraph")
+            .field("calculus", &C::NAME)
+            .field("landmarks", &self.landmarks)
+            .field("constrained_triples", &constrained)
+            .finish()
+    }
+}
+
+impl<C: Calculus> Hypergraph<C> {
+    /// Internal indices `[i, j, k]` and stored relations of every edge, in storage order.
+    pub(super) fn triples_internal(&self) -> impl Iterator<Item = ([usize; 3], [u32; 3])> + '_ {
+        let mut ijk = [0usize, 1, 2];
+        self.edges.iter().enumerate().map(move |(r, e)| {
+            let current = ijk;
+            debug_assert_eq!(rank(current[0], current[1], current[2]), r);
+            ijk = successor(ijk);
+            (current, *e)
+        })
+    }
+}
+
+/// The next triple in rank order: `i` counts up to `j`, then `j` up to `k`, then `k`.
+fn successor([i, j, k]: [usize; 3]) -> [usize; 3] {
+    if i + 1 < j {
+        [i + 1, j, k]
+    } else if j + 1 < k {
+        [0, j + 1, k]
+    } else {
+        [0, 1, k + 1]
+    }
+}
+
+/// Iterator of [`Hypergraph::triples`].
+pub struct Triples<'a> {
+    landmarks: &'a [LandmarkId],
+    edges: &'a [[u32; 3]],
+    next: usize,
+    ijk: [usize; 3],
+}
+
+impl Iterator for Triples<'_> {
+    type Item = (LandmarkId, LandmarkId, LandmarkId, [RelationSet; 3]);
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let edge = self.edges.get(self.next)?;
+        let [i, j, k] = self.ijk;
+        self.next += 1;
+        self.ijk = successor(self.ijk);
+        Some((
+            self.landmarks[i],
+            self.landmarks[j],
+            self.landmarks[k],
+            edge.map(RelationSet::from_bits),
+        ))
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = self.edges.len() - self.next;
+        (left, Some(left))
+    }
+}
+
+impl ExactSizeIterator for Triples<'_> {}
