@@ -8,5 +8,5 @@ pub mod fdc;
 pub mod feasibility;
 pub mod generation;
 pub mod geometry;
-pub mod measurement;
 pub mod map;
+pub mod measurement;
