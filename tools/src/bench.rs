@@ -5,6 +5,7 @@
 //! - with `--closure`: path-consistency closure of complete random maps (000 §VI-B).
 
 use clap::Parser;
+use qrm::measurement::{Bearing, Panorama, RangeOrder};
 use qrm::calculus::{Calculus, RelationSet};
 use qrm::edc::Edc;
 use qrm::edc::{fixed_point, free_point, region_constraints};
@@ -31,6 +32,54 @@ struct Args {
     /// Random extra states added to the true state of every relation (with `--closure`).
     #[arg(long, default_value_t = 3)]
     extra: usize,
+    /// Time the measurement of a random panorama showing this many landmarks (repeatable):
+    /// every triple, every region open, total range order.
+    #[arg(long, num_args = 1.., value_name = "N")]
+    measure: Vec<usize>,
+    /// Bearing uncertainty (± degrees) for `--measure`.
+    #[arg(long, default_value_t = 0.0)]
+    uncertainty: f64,
+}
+
+/// Measures one random panorama of `n` landmarks (uniform in a square around the camera,
+/// bearings perturbed within `±uncertainty`), five times; prints the minimum and median wall
+/// time and the mean number of open regions per relation.
+fn bench_measure(n: usize, uncertainty_deg: f64) {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(n as u64);
+    let delta = uncertainty_deg.to_radians();
+    let points: Vec<Point> = (0..n)
+        .map(|_| Point::new(rng.random_range(-10.0..10.0), rng.random_range(-10.0..10.0)))
+        .collect();
+    let bearings = points
+        .iter()
+        .map(|p| Bearing {
+            angle: p.y.atan2(p.x) + if delta > 0.0 { rng.random_range(-delta..delta) } else { 0.0 },
+            uncertainty: delta,
+        })
+        .collect();
+    let mut nearest_first: Vec<usize> = (0..n).collect();
+    nearest_first.sort_by(|&i, &j| points[i].distance(Point::new(0.0, 0.0)).total_cmp(&points[j].distance(Point::new(0.0, 0.0))));
+    let order = RangeOrder::total(&nearest_first).expect("a chain is acyclic");
+    let panorama = Panorama::new(bearings, order).expect("valid panorama");
+    let engine = BranchAndBound::default();
+    let mut times = Vec::new();
+    let mut open = 0usize;
+    let mut relations = 0usize;
+    for _ in 0..5 {
+        let start = Instant::now();
+        let measured = panorama.measure_all::<Edc, _>(|_| [Edc::universe(); 3], &engine);
+        times.push(start.elapsed().as_secs_f64());
+        open = measured.iter().flat_map(|m| m.states).map(|s| s.len()).sum();
+        relations = measured.len() * 3;
+    }
+    times.sort_by(f64::total_cmp);
+    println!(
+        "measure n={n} ±{uncertainty_deg}°: {} triples, min {:.1} ms, median {:.1} ms, {:.2} open regions per relation",
+        relations / 3,
+        times[0] * 1e3,
+        times[2] * 1e3,
+        open as f64 / relations.max(1) as f64
+    );
 }
 
 /// Fuses a complete random network of `n` landmarks in one update: every relation of every
@@ -118,6 +167,12 @@ fn time_decisions(problems: &[(Vec<f64>, Vec<f64>, Vec<Quadratic>)]) -> (f64, f6
 
 fn main() {
     let args = Args::parse();
+    if !args.measure.is_empty() {
+        for &n in &args.measure {
+            bench_measure(n, args.uncertainty);
+        }
+        return;
+    }
     if !args.closure.is_empty() {
         for &n in &args.closure {
             bench_closure::<Edc>(n, args.extra);

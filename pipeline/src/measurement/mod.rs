@@ -7,10 +7,12 @@
 //! (up to the feasibility engine's documented margin).
 
 mod range_order;
+mod sweep;
 mod triple;
 
 pub use range_order::{RangeOrder, RangeOrderError};
-pub use triple::{measure_triple_edc, TripleRelations};
+pub use sweep::sweep_regions;
+pub use triple::{by_search, by_sweep, measure_triple_edc, TripleRelations};
 
 use crate::calculus::{Calculus, RelationSet};
 use crate::feasibility::BranchAndBound;

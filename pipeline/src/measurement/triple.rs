@@ -11,10 +11,11 @@
 //! arrangement is lost however different the ranges are.) With exact bearings this is the
 //! paper's two-unknown problem; each uncertain bearing adds one unknown.
 
+use super::sweep::sweep_regions;
 use super::Bearing;
 use crate::edc::region_constraints;
 use crate::feasibility::{BranchAndBound, Linear, Problem, Quadratic};
-use crate::geometry::{Coordinate, Point2};
+use crate::geometry::{Coordinate, Point, Point2};
 use crate::calculus::{Calculus, RelationSet};
 use crate::edc;
 
@@ -47,19 +48,59 @@ pub fn measure_triple_edc(
             .intersection(tables.left(candidates[1]))
             .intersection(tables.right(candidates[0])),
     ];
+    Some(if bearings.iter().all(|b| b.uncertainty == 0.0) {
+        by_sweep(bearings, nearer, candidates)
+    } else {
+        by_search(bearings, nearer, candidates, engine)
+    })
+}
+
+/// Exact bearings: each relation decided by [`sweep_regions`].
+pub fn by_sweep(
+    bearings: [Bearing; 3],
+    nearer: &[(usize, usize)],
+    candidates: TripleRelations,
+) -> TripleRelations {
+    let u = bearings.map(|b| Point::new(b.angle.cos(), b.angle.sin()));
+    std::array::from_fn(|k| {
+        if candidates[k].is_empty() {
+            return RelationSet::EMPTY;
+        }
+        let rotate = |p: usize| (p + 3 - k) % 3;
+        let nearer: Vec<(usize, usize)> =
+            nearer.iter().map(|&(p, q)| (rotate(p), rotate(q))).collect();
+        sweep_regions(
+            [u[k], u[(k + 1) % 3], u[(k + 2) % 3]],
+            &nearer,
+            candidates[k],
+        )
+    })
+}
+
+/// Any bearings: regions reached at the nominal bearings (by sweep) are possible; one
+/// branch-and-bound search over the bearing intervals decides the regions of all three
+/// relations that are left.
+pub fn by_search(
+    bearings: [Bearing; 3],
+    nearer: &[(usize, usize)],
+    candidates: TripleRelations,
+    engine: &BranchAndBound,
+) -> TripleRelations {
+    let nominal = by_sweep(bearings.map(|b| Bearing::exact(b.angle)), nearer, candidates);
+    let undecided: TripleRelations = std::array::from_fn(|k| candidates[k].difference(nominal[k]));
     let formulation = Formulation::new(&bearings, nearer);
     let mut index = Vec::new();
     let mut alternatives = Vec::new();
-    for (k, set) in candidates.iter().enumerate() {
+    for (k, set) in undecided.iter().enumerate() {
         let [p, q, w] = formulation.rotated(k);
         for region in set.iter() {
             index.push((k, region));
             alternatives.push(region_constraints(p, q, w, region));
         }
     }
-    let mut result = [RelationSet::EMPTY; 3];
+    let mut result = nominal;
     if alternatives.is_empty() {
-        return Some(result);
+        return result;
     }
     let problem = Problem {
         lower: formulation.lower.clone(),
@@ -73,7 +114,7 @@ pub fn measure_triple_edc(
             result[k] = result[k].with(region);
         }
     }
-    Some(result)
+    result
 }
 
 /// Whether the three bearings are exact and lie on one line through the camera, so that the

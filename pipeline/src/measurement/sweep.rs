@@ -1,0 +1,382 @@
+//! Exact-bearing measurement by sweeping (000 §IV with exact bearings, decided without branch
+//! and bound).
+//!
+//! Fix `A = u_A` (scale), `B = r·u_B`, `C = s·u_C`. For one `r`, C runs along its ray and each
+//! EDC boundary function is a quadratic in `s`, so the ray splits into at most 13 intervals of
+//! constant region, found from the roots. The sequence of regions along the ray can only change
+//! at *critical* values of `r` where
+//! - the ray passes through a vertex of the EDC arrangement of `AB` (two roots meet): each
+//!   vertex is a fixed similarity-covariant point, affine in `r` — one linear equation;
+//! - a circle becomes tangent to the ray (a double root): a quadratic in `r`;
+//! - a line becomes parallel to the ray (a root escapes to infinity): linear in `r`;
+//! - a root meets an end of the allowed `s` interval: the camera (`s = 0`), `|C| = |A|`
+//!   (`s = 1`) or `|C| = |B|` (`s = r`): quadratics in `r`.
+//!
+//! Between consecutive critical values the sequence is constant, and a region met exactly at a
+//! critical value is met just beside it too (regions are open). So one `r` inside every gap and
+//! one `s` inside every ray interval visit every region the observation allows. Each sample is
+//! classified with a tolerance: a boundary value within rounding of zero counts as both signs,
+//! so sampling a numerically tiny interval can add a neighbour but never lose a region.
+
+use crate::calculus::RelationSet;
+use crate::edc::region_of_signs;
+use crate::geometry::{boundary_values, Coordinate, Point, Point2};
+use std::ops::{Add, Sub};
+
+/// Vertices of the EDC arrangement in the frame `A = (0,0)`, `B = (0,1)` as `(α, β)` with
+/// `V = A + α·(B − A) + β·rot90(B − A)`: A, B, the midpoint, the far ends of the circles on the
+/// line AB, the feet of the perpendiculars on the circles, and the two lune corners.
+const VERTICES: [(f64, f64); 11] = [
+    (0.0, 0.0),
+    (1.0, 0.0),
+    (0.5, 0.0),
+    (-1.0, 0.0),
+    (2.0, 0.0),
+    (0.0, 1.0),
+    (0.0, -1.0),
+    (1.0, 1.0),
+    (1.0, -1.0),
+    (0.5, 0.866_025_403_784_438_6),
+    (0.5, -0.866_025_403_784_438_6),
+];
+
+/// Relative size below which a boundary value counts as zero when classifying a sample.
+const ZERO_TOLERANCE: f64 = 1e-9;
+
+/// Relative width below which a gap between critical values is not sampled.
+const GAP_TOLERANCE: f64 = 1e-9;
+
+/// The EDC regions of `AB:C` reachable when A, B, C lie on the rays `u` (unit vectors, camera
+/// at the origin) with ranges ordered by `nearer` (`(p, q)`: landmark `p` of `[A, B, C]` is
+/// nearer than `q`; transitively closed), among `wanted` (the sweep stops once all are found).
+pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationSet) -> RelationSet {
+    let is_nearer = |p: usize, q: usize| nearer.contains(&(p, q));
+    let functions = BoundaryPolynomials::new(u);
+
+    // Allowed r: B vs A.
+    let r_lo = if is_nearer(0, 1) { 1.0 } else { 0.0 };
+    let r_hi = if is_nearer(1, 0) { 1.0 } else { f64::INFINITY };
+
+    let mut critical = vec![1.0];
+    for &(alpha, beta) in &VERTICES {
+        // V(r) = P + r·Q with A = u_A, B = r·u_B; on the ray ⇔ cross(u_C, V) = 0.
+        let p = Point::new(
+            (1.0 - alpha) * u[0].x + beta * u[0].y,
+            (1.0 - alpha) * u[0].y - beta * u[0].x,
+        );
+        let q = Point::new(alpha * u[1].x - beta * u[1].y, alpha * u[1].y + beta * u[1].x);
+        push_roots(&mut critical, 0.0, cross(u[2], q), cross(u[2], p));
+    }
+    for f in &functions.0 {
+        // f = ss·s² + (rs·r + s1)·s + (rr·r² + r1·r + c).
+        push_roots(&mut critical, 0.0, f.rs, f.s); // parallel line: the s-coefficient vanishes
+        push_roots(&mut critical, f.rr, f.r, f.c); // camera on the boundary
+        push_roots(&mut critical, f.rr, f.r + f.rs, f.c + f.s + f.ss); // s = 1
+        push_roots(&mut critical, f.rr + f.rs + f.ss, f.r + f.s, f.c); // s = r
+        // Discriminant (rs·r + s1)² − 4·ss·(rr·r² + r1·r + c) = 0.
+        push_roots(
+            &mut critical,
+            f.rs * f.rs - 4.0 * f.ss * f.rr,
+            2.0 * f.rs * f.s - 4.0 * f.ss * f.r,
+            f.s * f.s - 4.0 * f.ss * f.c,
+        );
+    }
+    let samples_r = gap_samples(&mut critical, r_lo, r_hi, 0.0);
+
+    let mut found = RelationSet::EMPTY;
+    let mut roots = Vec::with_capacity(16);
+    for r in samples_r {
+        // Allowed s: C vs A (s vs 1) and C vs B (s vs r).
+        let mut s_lo: f64 = 0.0;
+        let mut s_hi = f64::INFINITY;
+        if is_nearer(0, 2) {
+            s_lo = s_lo.max(1.0);
+        }
+        if is_nearer(2, 0) {
+            s_hi = s_hi.min(1.0);
+        }
+        if is_nearer(1, 2) {
+            s_lo = s_lo.max(r);
+        }
+        if is_nearer(2, 1) {
+            s_hi = s_hi.min(r);
+        }
+        if s_lo >= s_hi {
+            continue;
+        }
+        roots.clear();
+        for f in &functions.0 {
+            push_roots(
+                &mut roots,
+                f.ss,
+                f.rs * r + f.s,
+                (f.rr * r + f.r) * r + f.c,
+            );
+        }
+        for s in gap_samples(&mut roots, s_lo, s_hi, r.max(1.0)) {
+            found = found.union(functions.regions_at(r, s));
+        }
+        if wanted.is_subset(found) {
+            break;
+        }
+    }
+    found.intersection(wanted)
+}
+
+/// Midpoints of the gaps between the sorted `points` inside `(lo, hi)`, plus a point inside
+/// each unbounded or end gap. Cuts closer than [`GAP_TOLERANCE`] × max(`scale`, |cut|) are one
+/// cut: such gaps are rounding artefacts of coinciding events (sampling one would land on a
+/// boundary and blur the result), or slivers thinner than the search engine's margin.
+fn gap_samples(points: &mut Vec<f64>, lo: f64, hi: f64, scale: f64) -> Vec<f64> {
+    points.retain(|&x| x > lo && x < hi);
+    points.sort_by(f64::total_cmp);
+    let mut cuts: Vec<f64> = Vec::with_capacity(points.len() + 2);
+    cuts.push(lo);
+    for &x in points.iter() {
+        let last = *cuts.last().expect("lo is a cut");
+        if x - last > GAP_TOLERANCE * scale.max(x.abs()) {
+            cuts.push(x);
+        }
+    }
+    if hi.is_finite() && hi - cuts[cuts.len() - 1] <= GAP_TOLERANCE * scale.max(hi.abs()) {
+        cuts.pop();
+        if cuts.is_empty() {
+            return Vec::new();
+        }
+    }
+    let mut samples: Vec<f64> = cuts.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+    let last = *cuts.last().expect("lo is a cut");
+    samples.push(if hi.is_finite() {
+        0.5 * (last + hi)
+    } else {
+        2.0 * last.max(1.0)
+    });
+    samples
+}
+
+/// Appends the positive real roots of `a·x² + b·x + c` (a linear or constant polynomial when
+/// the leading coefficients vanish); nothing when the polynomial vanishes identically.
+fn push_roots(out: &mut Vec<f64>, a: f64, b: f64, c: f64) {
+    let scale = a.abs().max(b.abs()).max(c.abs());
+    if scale == 0.0 || !scale.is_finite() {
+        return;
+    }
+    let (a, b, c) = (a / scale, b / scale, c / scale);
+    if a.abs() < 1e-14 {
+        if b.abs() > 1e-14 {
+            out.push(-c / b);
+        }
+        return;
+    }
+    let mut disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        // A double root perturbed by rounding still marks a tangency.
+        if disc > -1e-12 {
+            disc = 0.0;
+        } else {
+            return;
+        }
+    }
+    // Numerically stable pair of roots.
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    if q != 0.0 {
+        out.push(q / a);
+        out.push(c / q);
+    } else {
+        out.push(0.0);
+    }
+    out.retain(|x| x.is_finite());
+}
+
+fn cross(u: Point, v: Point) -> f64 {
+    u.x * v.y - u.y * v.x
+}
+
+/// A number affine in `(r, s)`: `r·r_coef + s·s_coef + c`.
+#[derive(Clone, Copy, Debug, Default)]
+struct Affine {
+    r: f64,
+    s: f64,
+    c: f64,
+}
+
+impl Sub for Affine {
+    type Output = Affine;
+    fn sub(self, o: Affine) -> Affine {
+        Affine {
+            r: self.r - o.r,
+            s: self.s - o.s,
+            c: self.c - o.c,
+        }
+    }
+}
+
+/// A quadratic polynomial in `(r, s)`.
+#[derive(Clone, Copy, Debug, Default)]
+struct Bivariate {
+    rr: f64,
+    rs: f64,
+    ss: f64,
+    r: f64,
+    s: f64,
+    c: f64,
+}
+
+impl Bivariate {
+    /// Value and the sum of the magnitudes of its terms (the scale of rounding errors).
+    fn eval(&self, r: f64, s: f64) -> (f64, f64) {
+        let terms = [
+            self.rr * r * r,
+            self.rs * r * s,
+            self.ss * s * s,
+            self.r * r,
+            self.s * s,
+            self.c,
+        ];
+        (terms.iter().sum(), terms.iter().map(|t| t.abs()).sum())
+    }
+}
+
+impl Add for Bivariate {
+    type Output = Bivariate;
+    fn add(self, o: Bivariate) -> Bivariate {
+        Bivariate {
+            rr: self.rr + o.rr,
+            rs: self.rs + o.rs,
+            ss: self.ss + o.ss,
+            r: self.r + o.r,
+            s: self.s + o.s,
+            c: self.c + o.c,
+        }
+    }
+}
+
+impl Sub for Bivariate {
+    type Output = Bivariate;
+    fn sub(self, o: Bivariate) -> Bivariate {
+        Bivariate {
+            rr: self.rr - o.rr,
+            rs: self.rs - o.rs,
+            ss: self.ss - o.ss,
+            r: self.r - o.r,
+            s: self.s - o.s,
+            c: self.c - o.c,
+        }
+    }
+}
+
+impl Coordinate for Affine {
+    type Product = Bivariate;
+    fn mul(&self, o: &Affine) -> Bivariate {
+        Bivariate {
+            rr: self.r * o.r,
+            rs: self.r * o.s + self.s * o.r,
+            ss: self.s * o.s,
+            r: self.r * o.c + self.c * o.r,
+            s: self.s * o.c + self.c * o.s,
+            c: self.c * o.c,
+        }
+    }
+}
+
+/// The six boundary functions of `AB:C` as polynomials in `(r, s)`.
+struct BoundaryPolynomials([Bivariate; 6]);
+
+impl BoundaryPolynomials {
+    fn new(u: [Point; 3]) -> BoundaryPolynomials {
+        let fixed = |p: Point| {
+            Point2::new(
+                Affine {
+                    c: p.x,
+                    ..Affine::default()
+                },
+                Affine {
+                    c: p.y,
+                    ..Affine::default()
+                },
+            )
+        };
+        let a = fixed(u[0]);
+        let b = Point2::new(
+            Affine {
+                r: u[1].x,
+                ..Affine::default()
+            },
+            Affine {
+                r: u[1].y,
+                ..Affine::default()
+            },
+        );
+        let c = Point2::new(
+            Affine {
+                s: u[2].x,
+                ..Affine::default()
+            },
+            Affine {
+                s: u[2].y,
+                ..Affine::default()
+            },
+        );
+        BoundaryPolynomials(boundary_values(&a, &b, &c))
+    }
+
+    /// Every region whose sign vector agrees with the boundary values at `(r, s)`, a value
+    /// within rounding of zero matching either sign.
+    fn regions_at(&self, r: f64, s: f64) -> RelationSet {
+        let mut signs = [0i8; 6];
+        let mut ambiguous = Vec::new();
+        for (i, f) in self.0.iter().enumerate() {
+            let (value, scale) = f.eval(r, s);
+            if value.abs() <= ZERO_TOLERANCE * scale {
+                ambiguous.push(i);
+                signs[i] = 1;
+            } else {
+                signs[i] = if value > 0.0 { 1 } else { -1 };
+            }
+        }
+        let mut out = RelationSet::EMPTY;
+        for pattern in 0u32..1 << ambiguous.len() {
+            for (bit, &i) in ambiguous.iter().enumerate() {
+                signs[i] = if pattern >> bit & 1 == 1 { 1 } else { -1 };
+            }
+            if let Some(region) = region_of_signs(signs) {
+                out = out.with(region);
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polynomials_match_the_boundary_functions() {
+        let u = [0.3f64, 2.0, -1.1].map(|t| Point::new(t.cos(), t.sin()));
+        let polys = BoundaryPolynomials::new(u);
+        for (r, s) in [(0.5, 2.0), (3.0, 0.1), (1.0, 1.0)] {
+            let b = Point::new(r * u[1].x, r * u[1].y);
+            let c = Point::new(s * u[2].x, s * u[2].y);
+            let direct = boundary_values(&u[0], &b, &c);
+            for (p, d) in polys.0.iter().zip(direct) {
+                assert!((p.eval(r, s).0 - d).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn roots_of_degenerate_polynomials() {
+        let mut out = Vec::new();
+        push_roots(&mut out, 1.0, -3.0, 2.0);
+        out.sort_by(f64::total_cmp);
+        assert_eq!(out, vec![1.0, 2.0]);
+        out.clear();
+        push_roots(&mut out, 0.0, 2.0, -1.0);
+        assert_eq!(out, vec![0.5]);
+        out.clear();
+        push_roots(&mut out, 0.0, 0.0, 0.0);
+        push_roots(&mut out, 1.0, 0.0, 1.0);
+        assert!(out.is_empty());
+    }
+}
