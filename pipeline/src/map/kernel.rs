@@ -158,12 +158,20 @@ impl Kernel {
     }
 
     /// `COMPOSE(ab_c, bc_d) ∩ bound`, stopping early once the union covers `bound`.
-    #[inline]
+    #[inline(always)]
     pub fn compose_within(&self, ab_c: u32, bc_d: u32, bound: u32) -> u32 {
         if (ab_c & ab_c.wrapping_sub(1)) | (bc_d & bc_d.wrapping_sub(1)) == 0 {
-            let cell = ab_c.trailing_zeros() as usize * PAIR_STRIDE + bc_d.trailing_zeros() as usize;
+            let cell =
+                ab_c.trailing_zeros() as usize * PAIR_STRIDE + bc_d.trailing_zeros() as usize;
             return self.pairs[cell] & bound;
         }
+        self.compose_sets(ab_c, bc_d, bound)
+    }
+
+    /// [`Kernel::compose_within`] when an input has several members: the union over the
+    /// members of the smaller input.
+    #[inline(never)]
+    fn compose_sets(&self, ab_c: u32, bc_d: u32, bound: u32) -> u32 {
         let (members, other, tables) = if ab_c.count_ones() <= bc_d.count_ones() {
             (ab_c, bc_d, &self.by_first)
         } else {
