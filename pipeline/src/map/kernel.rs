@@ -42,7 +42,7 @@ impl ChunkTable {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn apply(&self, set: u32) -> u32 {
         if set.is_power_of_two() {
             return self.single[set.trailing_zeros() as usize];
@@ -78,7 +78,7 @@ pub(crate) struct Kernel {
     /// `pairs[b1 · PAIR_STRIDE + b2]` = `COMPOSE` of the single relations of bits `b1`, `b2`:
     /// one load for the common case of a tight map (both inputs singletons). Row and column
     /// 32 (the `trailing_zeros` of an empty set) are empty, as `COMPOSE(∅, ·)` is.
-    pairs: Vec<u32>,
+    pairs: Box<[u32; PAIR_STRIDE * PAIR_STRIDE]>,
 }
 
 /// Row length of [`Kernel::pairs`]: bit indices 0..=31 and 32 for the empty set.
@@ -104,7 +104,7 @@ impl Kernel {
         let by_second = (1..=n)
             .map(|r2| ChunkTable::new(&image(&|r1| tables.compose_base(r1, r2))))
             .collect();
-        let mut pairs = vec![0u32; PAIR_STRIDE * PAIR_STRIDE];
+        let mut pairs = Box::new([0u32; PAIR_STRIDE * PAIR_STRIDE]);
         for r1 in 1..=n {
             for r2 in 1..=n {
                 pairs[(r1 as usize - 1) * PAIR_STRIDE + r2 as usize - 1] =

@@ -13,7 +13,10 @@ pub(super) type Revision = (usize, [u32; 3]);
 /// The 24 ordered relations of a 4-set with positions `0 < 1 < 2 < 3` (internal index order).
 /// Relation `6e + o` lies in edge `e`, the triple without position `e`: for `o < 3` it is
 /// stored slot `o` of that edge (see `index`), for `o ≥ 3` the INVERSE of slot `o − 3`.
-type Relations = [u32; 24];
+/// Indices are masked with `SLOTS − 1` (always in bounds, no check in the hot loop); entries
+/// 24..32 are unused.
+type Relations = [u32; SLOTS];
+const SLOTS: usize = 32;
 
 /// Index into [`Relations`] of `ab:c` for distinct positions (the rule of `index::locate`).
 const fn ordered(a: usize, b: usize, c: usize) -> usize {
@@ -70,14 +73,16 @@ pub(super) fn close_quad(
     out: &mut Vec<Revision>,
 ) -> u64 {
     let u = kernel.universe;
-    let skip_universe = kernel.universe_neutral;
     let stored = ranks.map(|r| edges[r]);
     // Every composition reads two different edges: with fewer than two constrained ones
     // nothing can be narrowed.
-    if skip_universe && stored.iter().filter(|s| **s != [u; 3]).count() < 2 {
+    if kernel.universe_neutral && stored.iter().filter(|s| **s != [u; 3]).count() < 2 {
         return 0;
     }
-    let mut v: Relations = [0; 24];
+    // An input equal to `skip` is unconstrained: the composition cannot narrow anything.
+    // (Stored relations are subsets of the universe, never `u32::MAX`.)
+    let skip = if kernel.universe_neutral { u } else { u32::MAX };
+    let mut v: Relations = [0; SLOTS];
     for (e, s) in stored.iter().enumerate() {
         set_edge(kernel, &mut v, e, *s);
     }
@@ -86,8 +91,9 @@ pub(super) fn close_quad(
     'stable: loop {
         let mut changed = false;
         for &[ab_c, bc_d, ab_d] in &COMPOSITIONS {
+            let (ab_c, bc_d, ab_d) = (ab_c & (SLOTS - 1), bc_d & (SLOTS - 1), ab_d & (SLOTS - 1));
             let (first, second) = (v[ab_c], v[bc_d]);
-            if skip_universe && (first == u || second == u) {
+            if first == skip || second == skip {
                 continue;
             }
             count += 1;
@@ -124,7 +130,7 @@ pub(super) fn close_quad(
 }
 
 /// Writes the stored relations `s` of edge `e` and their INVERSE images into `v`.
-#[inline]
+#[inline(always)]
 fn set_edge(kernel: &Kernel, v: &mut Relations, e: usize, s: [u32; 3]) {
     for (o, x) in s.into_iter().enumerate() {
         v[6 * e + o] = x;
