@@ -13,7 +13,7 @@
 //! the greatest path-consistent refinement is unique, so the result does not depend on the
 //! order.
 
-use super::index::{choose2, choose3, rank, unrank};
+use super::index::{choose2, choose3, choose4, rank, unrank};
 use super::quad::{close_quad, Revision};
 use super::transaction::{BitSet, Transaction};
 use crate::calculus::Calculus;
@@ -22,18 +22,56 @@ use crate::calculus::Calculus;
 /// edges ([`around_queued`]) when at least `1 / DENSE` of the edges are queued.
 const DENSE: usize = 4;
 
+/// Which 4-sets a round must close: those containing an edge of the round (`queued`) that
+/// may have changed after the 4-set was last closed. `since[e]`, when present, is the
+/// storage-order position ([`key`]) of the 4-set that last narrowed `e` during the round
+/// before, which closed every 4-set in that order: the 4-sets from there on were closed with
+/// `e` as it is now, so only those before need closing again for `e`. This spares most of
+/// the second round after a complete sweep, where the edges narrowed were mostly narrowed
+/// early in their 4-sets.
+struct Pending<'a> {
+    queued: &'a BitSet,
+    since: Option<&'a [u64]>,
+}
+
+impl Pending<'_> {
+    /// Whether edge `e` makes the 4-set at position `key` need closing.
+    #[inline]
+    fn needs(&self, e: usize, key: u64) -> bool {
+        self.queued.contains(e) && self.since.is_none_or(|since| key < since[e])
+    }
+}
+
+/// Storage-order position of the 4-set `{a, b, c, d}`, `a < b < c < d`, whose edge without
+/// `d` has rank `abc`: its rank in the combinatorial number system, `C(d,4) + rank(a,b,c)`.
+fn key(d: usize, abc: usize) -> u64 {
+    (choose4(d) + abc) as u64
+}
+
 /// Runs the closure until the worklist is empty. On a contradiction returns the edge rank and
 /// slot of the relation that would become empty.
 pub(super) fn close<C: Calculus>(tx: &mut Transaction<'_, C>) -> Result<(), (usize, usize)> {
-    let mut in_round = BitSet::new(tx.map.edges.len());
+    let edges = tx.map.edges.len();
+    let mut in_round = BitSet::new(edges);
+    let mut since: Option<Vec<u64>> = None;
     while !tx.frontier.is_empty() {
         tx.report.rounds += 1;
         let round = std::mem::take(&mut tx.frontier);
         std::mem::swap(&mut in_round, &mut tx.queued);
-        if round.len() * DENSE >= tx.map.edges.len() {
-            sweep(tx, &in_round)?;
+        let previous = since.take();
+        let pending = Pending {
+            queued: &in_round,
+            since: previous.as_deref(),
+        };
+        if round.len() == edges {
+            // Every 4-set is closed in storage order: record where each edge last changed.
+            let mut narrowed_at = vec![u64::MAX; edges];
+            sweep(tx, &pending, Some(&mut narrowed_at))?;
+            since = Some(narrowed_at);
+        } else if round.len() * DENSE >= edges {
+            sweep(tx, &pending, None)?;
         } else {
-            around_queued(tx, &round, &in_round)?;
+            around_queued(tx, &round, &pending)?;
         }
         for &t in &round {
             in_round.remove(t);
@@ -43,25 +81,28 @@ pub(super) fn close<C: Calculus>(tx: &mut Transaction<'_, C>) -> Result<(), (usi
 }
 
 /// Closes the 4-set of edges `ranks` ([`close_quad`]) and intersects what it narrowed into
-/// the map, which queues those edges for the next round.
+/// the map, which queues those edges for the next round; the narrowed edges are left in
+/// `out`.
 fn close_in_place<C: Calculus>(
     tx: &mut Transaction<'_, C>,
     ranks: [usize; 4],
     out: &mut Vec<Revision>,
 ) -> Result<(), (usize, usize)> {
     tx.report.compositions += close_quad(tx.kernel, &tx.map.edges, ranks, out);
-    for (rank, mask) in out.drain(..) {
+    for &(rank, mask) in out.iter() {
         tx.intersect(rank, mask).map_err(|slot| (rank, slot))?;
     }
     Ok(())
 }
 
-/// Closes every 4-set that contains an edge of `in_round`. The loops follow the storage
-/// order: for fixed `b < c < d`, the edges `{a, b, c}`, `{a, b, d}` and `{a, c, d}` are
-/// consecutive in `a`, and no rank is computed from scratch.
+/// Closes every 4-set that `pending` asks for, in storage order; with `narrowed_at`, records
+/// for every edge narrowed the [`key`] of the 4-set that last narrowed it. The loops follow
+/// the storage order: for fixed `b < c < d`, the edges `{a, b, c}`, `{a, b, d}` and
+/// `{a, c, d}` are consecutive in `a`, and no rank is computed from scratch.
 fn sweep<C: Calculus>(
     tx: &mut Transaction<'_, C>,
-    in_round: &BitSet,
+    pending: &Pending<'_>,
+    mut narrowed_at: Option<&mut Vec<u64>>,
 ) -> Result<(), (usize, usize)> {
     let n = tx.map.len();
     let mut out = Vec::new();
@@ -73,9 +114,18 @@ fn sweep<C: Calculus>(
                 let b2 = choose2(b);
                 let bcd = base_d + c2 + b;
                 for a in 0..b {
-                    let ranks = [bcd, base_d + c2 + a, base_d + b2 + a, base_c + b2 + a];
-                    if ranks.iter().any(|&r| in_round.contains(r)) {
-                        close_in_place(tx, ranks, &mut out)?;
+                    let abc = base_c + b2 + a;
+                    let ranks = [bcd, base_d + c2 + a, base_d + b2 + a, abc];
+                    let key = key(d, abc);
+                    if !ranks.iter().any(|&r| pending.needs(r, key)) {
+                        continue;
+                    }
+                    out.clear();
+                    close_in_place(tx, ranks, &mut out)?;
+                    if let Some(at) = narrowed_at.as_deref_mut() {
+                        for &(rank, _) in &out {
+                            at[rank] = key;
+                        }
                     }
                 }
             }
@@ -84,13 +134,13 @@ fn sweep<C: Calculus>(
     Ok(())
 }
 
-/// Closes every 4-set that contains an edge of `round` (whose members are `in_round`), going
-/// through the edges: the 4-sets `{x, y, z, w}` of queued edge `{x, y, z}` for every other
-/// landmark `w`, each from the queued edge of smallest rank among its four.
+/// Closes every 4-set that `pending` asks for, going through the edges of `round`: the
+/// 4-sets `{x, y, z, w}` of edge `{x, y, z}` for every other landmark `w`, each from the
+/// edge of smallest rank among its four that asks for it.
 fn around_queued<C: Calculus>(
     tx: &mut Transaction<'_, C>,
     round: &[usize],
-    in_round: &BitSet,
+    pending: &Pending<'_>,
 ) -> Result<(), (usize, usize)> {
     let n = tx.map.len();
     let mut out = Vec::new();
@@ -105,9 +155,11 @@ fn around_queued<C: Calculus>(
                 _ => continue,
             };
             let ranks = quad_ranks(q);
-            if ranks.iter().any(|&r| r < t && in_round.contains(r)) {
+            let key = key(q[3], ranks[3]);
+            if !pending.needs(t, key) || ranks.iter().any(|&r| r < t && pending.needs(r, key)) {
                 continue;
             }
+            out.clear();
             close_in_place(tx, ranks, &mut out)?;
         }
     }
