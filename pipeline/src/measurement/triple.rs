@@ -12,11 +12,11 @@
 //! paper's two-unknown problem; each uncertain bearing adds one unknown.
 
 use super::Bearing;
-use crate::calculus::{Calculus, RelationSet};
-use crate::edc;
 use crate::edc::region_constraints;
 use crate::feasibility::{BranchAndBound, Linear, Problem, Quadratic};
 use crate::geometry::{Coordinate, Point2};
+use crate::calculus::{Calculus, RelationSet};
+use crate::edc;
 
 /// The three relations of a triple `(A, B, C)` stored in a map edge: `AB:C`, `BC:A`, `CA:B`.
 pub type TripleRelations = [RelationSet; 3];
