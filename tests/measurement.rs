@@ -80,11 +80,10 @@ fn violations<C: Calculus>(count: usize, delta: f64, seed: u64) -> usize {
                 let Some(truth) = true_relations::<C>(&scene.landmarks) else {
                     continue;
                 };
-                let measured = scene.panorama.measure_triple::<C>(
-                    [0, 1, 2],
-                    [C::universe(); 3],
-                    &engine,
-                );
+                let measured =
+                    scene
+                        .panorama
+                        .measure_triple::<C>([0, 1, 2], [C::universe(); 3], &engine);
                 if (0..3).any(|k| !measured[k].contains(truth[k])) {
                     eprintln!(
                         "violation: {:?} truth {truth:?} measured {:?}",

@@ -40,9 +40,10 @@ pub trait Calculus: Send + Sync + 'static {
 
     /// The EDC regions a measurement must test when `open` relations are still possible.
     fn edc_candidates(open: RelationSet) -> RelationSet {
-        RelationSet::from_relations(
-            (1..=crate::edc::REGIONS)
-                .filter(|&r| !Self::from_edc(RelationSet::single(r)).intersection(open).is_empty()),
-        )
+        RelationSet::from_relations((1..=crate::edc::REGIONS).filter(|&r| {
+            !Self::from_edc(RelationSet::single(r))
+                .intersection(open)
+                .is_empty()
+        }))
     }
 }

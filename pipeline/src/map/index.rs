@@ -24,6 +24,15 @@ pub(crate) const fn choose3(x: usize) -> usize {
     }
 }
 
+/// `C(x, 4)`: the number of 4-sets among `x` landmarks.
+pub(crate) const fn choose4(x: usize) -> usize {
+    if x < 4 {
+        0
+    } else {
+        choose3(x) * (x - 3) / 4
+    }
+}
+
 /// Rank of the triple `i < j < k`.
 pub(crate) const fn rank(i: usize, j: usize, k: usize) -> usize {
     choose3(k) + choose2(j) + i
@@ -121,6 +130,7 @@ mod tests {
                 }
             }
             assert_eq!(choose3(k + 1), expected);
+            assert_eq!(choose4(k + 1), choose4(k) + choose3(k));
         }
     }
 

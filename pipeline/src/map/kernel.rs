@@ -42,7 +42,7 @@ impl ChunkTable {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn apply(&self, set: u32) -> u32 {
         if set.is_power_of_two() {
             return self.single[set.trailing_zeros() as usize];
@@ -75,7 +75,14 @@ pub(crate) struct Kernel {
     by_first: Vec<ChunkTable>,
     /// Per second relation `r2`: `COMPOSE(·, r2)` over chunks of the first set.
     by_second: Vec<ChunkTable>,
+    /// `pairs[b1 · PAIR_STRIDE + b2]` = `COMPOSE` of the single relations of bits `b1`, `b2`:
+    /// one load for the common case of a tight map (both inputs singletons). Row and column
+    /// 32 (the `trailing_zeros` of an empty set) are empty, as `COMPOSE(∅, ·)` is.
+    pairs: Box<[u32; PAIR_STRIDE * PAIR_STRIDE]>,
 }
+
+/// Row length of [`Kernel::pairs`]: bit indices 0..=31 and 32 for the empty set.
+const PAIR_STRIDE: usize = 33;
 
 impl Kernel {
     fn new(tables: &OperatorTables, universe: RelationSet) -> Kernel {
@@ -97,6 +104,13 @@ impl Kernel {
         let by_second = (1..=n)
             .map(|r2| ChunkTable::new(&image(&|r1| tables.compose_base(r1, r2))))
             .collect();
+        let mut pairs = Box::new([0u32; PAIR_STRIDE * PAIR_STRIDE]);
+        for r1 in 1..=n {
+            for r2 in 1..=n {
+                pairs[(r1 as usize - 1) * PAIR_STRIDE + r2 as usize - 1] =
+                    tables.compose_base(r1, r2).bits();
+            }
+        }
         let u = universe.bits();
         let mut kernel = Kernel {
             universe: u,
@@ -108,6 +122,7 @@ impl Kernel {
             prev: ChunkTable::new(&prev),
             by_first,
             by_second,
+            pairs,
         };
         let covers = |s: u32| s & u == u;
         kernel.universe_neutral = covers(kernel.inverse.apply(u))
@@ -143,8 +158,20 @@ impl Kernel {
     }
 
     /// `COMPOSE(ab_c, bc_d) ∩ bound`, stopping early once the union covers `bound`.
-    #[inline]
+    #[inline(always)]
     pub fn compose_within(&self, ab_c: u32, bc_d: u32, bound: u32) -> u32 {
+        if (ab_c & ab_c.wrapping_sub(1)) | (bc_d & bc_d.wrapping_sub(1)) == 0 {
+            let cell =
+                ab_c.trailing_zeros() as usize * PAIR_STRIDE + bc_d.trailing_zeros() as usize;
+            return self.pairs[cell] & bound;
+        }
+        self.compose_sets(ab_c, bc_d, bound)
+    }
+
+    /// [`Kernel::compose_within`] when an input has several members: the union over the
+    /// members of the smaller input.
+    #[inline(never)]
+    fn compose_sets(&self, ab_c: u32, bc_d: u32, bound: u32) -> u32 {
         let (members, other, tables) = if ab_c.count_ones() <= bc_d.count_ones() {
             (ab_c, bc_d, &self.by_first)
         } else {
@@ -195,8 +222,11 @@ mod tests {
         let u = C::universe();
         assert!(k.universe_neutral, "{}", C::NAME);
         // Set operations agree with the plain unions of OperatorTables on assorted sets.
+        // Assorted sets, every singleton (the pair table) and the empty set.
         let sets: Vec<RelationSet> = (0..200u32)
             .map(|s| RelationSet::from_bits(s.wrapping_mul(2_654_435_761) & u.bits()))
+            .chain(u.iter().map(RelationSet::single))
+            .chain([RelationSet::EMPTY])
             .collect();
         for &a in &sets {
             assert_eq!(k.inverse(a.bits()), t.inverse(a).bits());

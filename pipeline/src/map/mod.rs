@@ -12,6 +12,7 @@ mod hypergraph;
 mod index;
 mod json;
 mod kernel;
+mod quad;
 mod transaction;
 mod update;
 

@@ -64,7 +64,10 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
             (1.0 - alpha) * u[0].x + beta * u[0].y,
             (1.0 - alpha) * u[0].y - beta * u[0].x,
         );
-        let q = Point::new(alpha * u[1].x - beta * u[1].y, alpha * u[1].y + beta * u[1].x);
+        let q = Point::new(
+            alpha * u[1].x - beta * u[1].y,
+            alpha * u[1].y + beta * u[1].x,
+        );
         push_roots(&mut critical, 0.0, cross(u[2], q), cross(u[2], p));
     }
     for f in &functions.0 {
@@ -73,7 +76,7 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
         push_roots(&mut critical, f.rr, f.r, f.c); // camera on the boundary
         push_roots(&mut critical, f.rr, f.r + f.rs, f.c + f.s + f.ss); // s = 1
         push_roots(&mut critical, f.rr + f.rs + f.ss, f.r + f.s, f.c); // s = r
-        // Discriminant (rs·r + s1)² − 4·ss·(rr·r² + r1·r + c) = 0.
+                                                                       // Discriminant (rs·r + s1)² − 4·ss·(rr·r² + r1·r + c) = 0.
         push_roots(
             &mut critical,
             f.rs * f.rs - 4.0 * f.ss * f.rr,
@@ -106,12 +109,7 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
         }
         roots.clear();
         for f in &functions.0 {
-            push_roots(
-                &mut roots,
-                f.ss,
-                f.rs * r + f.s,
-                (f.rr * r + f.r) * r + f.c,
-            );
+            push_roots(&mut roots, f.ss, f.rs * r + f.s, (f.rr * r + f.r) * r + f.c);
         }
         for s in gap_samples(&mut roots, s_lo, s_hi, r.max(1.0)) {
             found = found.union(functions.regions_at(r, s));

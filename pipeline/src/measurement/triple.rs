@@ -13,11 +13,11 @@
 
 use super::sweep::sweep_regions;
 use super::Bearing;
+use crate::calculus::{Calculus, RelationSet};
+use crate::edc;
 use crate::edc::region_constraints;
 use crate::feasibility::{BranchAndBound, Linear, Problem, Quadratic};
 use crate::geometry::{Coordinate, Point, Point2};
-use crate::calculus::{Calculus, RelationSet};
-use crate::edc;
 
 /// The three relations of a triple `(A, B, C)` stored in a map edge: `AB:C`, `BC:A`, `CA:B`.
 pub type TripleRelations = [RelationSet; 3];
@@ -67,8 +67,10 @@ pub fn by_sweep(
             return RelationSet::EMPTY;
         }
         let rotate = |p: usize| (p + 3 - k) % 3;
-        let nearer: Vec<(usize, usize)> =
-            nearer.iter().map(|&(p, q)| (rotate(p), rotate(q))).collect();
+        let nearer: Vec<(usize, usize)> = nearer
+            .iter()
+            .map(|&(p, q)| (rotate(p), rotate(q)))
+            .collect();
         sweep_regions(
             [u[k], u[(k + 1) % 3], u[(k + 2) % 3]],
             &nearer,
@@ -86,7 +88,11 @@ pub fn by_search(
     candidates: TripleRelations,
     engine: &BranchAndBound,
 ) -> TripleRelations {
-    let nominal = by_sweep(bearings.map(|b| Bearing::exact(b.angle)), nearer, candidates);
+    let nominal = by_sweep(
+        bearings.map(|b| Bearing::exact(b.angle)),
+        nearer,
+        candidates,
+    );
     let undecided: TripleRelations = std::array::from_fn(|k| candidates[k].difference(nominal[k]));
     let formulation = Formulation::new(&bearings, nearer);
     let mut index = Vec::new();
