@@ -1,39 +1,22 @@
-use qrm::calculus::Calculus;
-use qrm::edc::Edc;
-use qrm::feasibility::{BranchAndBound, Settings};
 use qrm::measurement::*;
-use rand::{Rng, SeedableRng};
+use qrm::geometry::Point;
+use qrm::edc;
 #[test]
 fn probe() {
-    for (boxes, relax) in [(500, true), (2000, true), (2000, false), (20000, true)] {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
-        let engine = BranchAndBound::new(Settings {
-            max_boxes: boxes,
-            use_relaxation: relax,
-            ..Settings::default()
-        });
-        let t0 = std::time::Instant::now();
-        let (mut nominal, mut total) = (0, 0);
-        for _ in 0..40 {
-            let b: [Bearing; 3] = std::array::from_fn(|_| Bearing {
-                angle: rng.random_range(0.0..6.28),
-                uncertainty: 0.01,
-            });
-            let nearer = [(0, 1), (1, 2), (0, 2)];
-            let s = by_sweep(
-                b.map(|x| Bearing::exact(x.angle)),
-                &nearer,
-                [Edc::universe(); 3],
-            );
-            let t = by_search(b, &nearer, [Edc::universe(); 3], &engine);
-            for k in 0..3 {
-                nominal += s[k].len();
-                total += t[k].len();
-            }
-        }
-        println!(
-            "boxes {boxes} relax {relax}: nominal {nominal} uncertain {total} in {:?}",
-            t0.elapsed()
-        );
-    }
+    let p = [Point::new(11.268649591496413, 11.54081464789538), Point::new(10.949760386396054, 7.977679204220196), Point::new(9.57462546423655, 11.707719600153158)];
+    let ang = [0.6845411351737586f64, -1.654402896663238, 3.0315981249627084];
+    let u = ang.map(|t| Point::new(t.cos(), t.sin()));
+    // camera = A - a u_A = B - b u_B  -> solve 2x2
+    let (dx, dy) = (p[0].x - p[1].x, p[0].y - p[1].y);
+    // a u_A - b u_B = A - B
+    let det = u[0].x * (-u[1].y) - (-u[1].x) * u[0].y;
+    let a = (dx * (-u[1].y) - (-u[1].x) * dy) / det;
+    let cam = Point::new(p[0].x - a * u[0].x, p[0].y - a * u[0].y);
+    let rho = p.map(|q| q.distance(cam));
+    println!("camera {cam:?} ranges {rho:?}");
+    let r = rho[1] / rho[0]; let s = rho[2] / rho[0];
+    println!("r {r} s {s}");
+    let a2 = u[0]; let b2 = Point::new(r*u[1].x, r*u[1].y); let c2 = Point::new(s*u[2].x, s*u[2].y);
+    println!("class {:?} values {:?}", edc::classify(a2,b2,c2), qrm::geometry::boundary_values(&a2,&b2,&c2));
+    println!("{}", sweep_regions(u, &[(0,1),(0,2)], qrm::calculus::RelationSet::all(20)));
 }

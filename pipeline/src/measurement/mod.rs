@@ -6,16 +6,17 @@
 //! bearings lie within their intervals and whose ranges respect the order is never excluded
 //! (up to the feasibility engine's documented margin).
 
+mod interval;
 mod range_order;
 mod sweep;
 mod triple;
 
 pub use range_order::{RangeOrder, RangeOrderError};
+pub use interval::by_intervals;
 pub use sweep::sweep_regions;
 pub use triple::{by_search, by_sweep, measure_triple_edc, TripleRelations};
 
 use crate::calculus::{Calculus, RelationSet};
-use crate::feasibility::BranchAndBound;
 use rayon::prelude::*;
 use std::f64::consts::FRAC_PI_4;
 use thiserror::Error;
@@ -102,11 +103,10 @@ impl Panorama {
         &self,
         landmarks: [usize; 3],
         open: TripleRelations,
-        engine: &BranchAndBound,
     ) -> TripleRelations {
         let bearings = landmarks.map(|i| self.bearings[i]);
         let nearer = self.order.restricted(&landmarks);
-        match measure_triple_edc(bearings, &nearer, open.map(C::edc_candidates), engine) {
+        match measure_triple_edc(bearings, &nearer, open.map(C::edc_candidates)) {
             Some(regions) => std::array::from_fn(|k| C::from_edc(regions[k]).intersection(open[k])),
             None => open,
         }
@@ -114,7 +114,7 @@ impl Panorama {
 
     /// Every triple `i < j < k` of the panorama, measured in parallel; `open` gives the
     /// relations still possible for a triple (all of the calculus' universe for a fresh map).
-    pub fn measure_all<C, F>(&self, open: F, engine: &BranchAndBound) -> Vec<TripleMeasurement>
+    pub fn measure_all<C, F>(&self, open: F) -> Vec<TripleMeasurement>
     where
         C: Calculus,
         F: Fn([usize; 3]) -> TripleRelations + Sync,
@@ -127,7 +127,7 @@ impl Panorama {
             .into_par_iter()
             .map(|landmarks| TripleMeasurement {
                 landmarks,
-                states: self.measure_triple::<C>(landmarks, open(landmarks), engine),
+                states: self.measure_triple::<C>(landmarks, open(landmarks)),
             })
             .collect()
     }

@@ -57,33 +57,7 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
     let r_lo = if is_nearer(0, 1) { 1.0 } else { 0.0 };
     let r_hi = if is_nearer(1, 0) { 1.0 } else { f64::INFINITY };
 
-    let mut critical = vec![1.0];
-    for &(alpha, beta) in &VERTICES {
-        // V(r) = P + r·Q with A = u_A, B = r·u_B; on the ray ⇔ cross(u_C, V) = 0.
-        let p = Point::new(
-            (1.0 - alpha) * u[0].x + beta * u[0].y,
-            (1.0 - alpha) * u[0].y - beta * u[0].x,
-        );
-        let q = Point::new(
-            alpha * u[1].x - beta * u[1].y,
-            alpha * u[1].y + beta * u[1].x,
-        );
-        push_roots(&mut critical, 0.0, cross(u[2], q), cross(u[2], p));
-    }
-    for f in &functions.0 {
-        // f = ss·s² + (rs·r + s1)·s + (rr·r² + r1·r + c).
-        push_roots(&mut critical, 0.0, f.rs, f.s); // parallel line: the s-coefficient vanishes
-        push_roots(&mut critical, f.rr, f.r, f.c); // camera on the boundary
-        push_roots(&mut critical, f.rr, f.r + f.rs, f.c + f.s + f.ss); // s = 1
-        push_roots(&mut critical, f.rr + f.rs + f.ss, f.r + f.s, f.c); // s = r
-                                                                       // Discriminant (rs·r + s1)² − 4·ss·(rr·r² + r1·r + c) = 0.
-        push_roots(
-            &mut critical,
-            f.rs * f.rs - 4.0 * f.ss * f.rr,
-            2.0 * f.rs * f.s - 4.0 * f.ss * f.r,
-            f.s * f.s - 4.0 * f.ss * f.c,
-        );
-    }
+    let mut critical = critical_ranges(u, &functions);
     let samples_r = gap_samples(&mut critical, r_lo, r_hi, 0.0);
 
     let mut found = RelationSet::EMPTY;
@@ -111,7 +85,7 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
         for f in &functions.0 {
             push_roots(&mut roots, f.ss, f.rs * r + f.s, (f.rr * r + f.r) * r + f.c);
         }
-        for s in gap_samples(&mut roots, s_lo, s_hi, r.max(1.0)) {
+        for s in gap_samples(&mut roots, s_lo, s_hi, r.min(1.0)) {
             found = found.union(functions.regions_at(r, s));
         }
         if wanted.is_subset(found) {
@@ -119,6 +93,38 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
         }
     }
     found.intersection(wanted)
+}
+
+/// The values of `r` at which the sequence of regions along C's ray can change (module doc).
+fn critical_ranges(u: [Point; 3], functions: &BoundaryPolynomials) -> Vec<f64> {
+    let mut critical = vec![1.0];
+    for &(alpha, beta) in &VERTICES {
+        // V(r) = P + r·Q with A = u_A, B = r·u_B; on the ray ⇔ cross(u_C, V) = 0.
+        let p = Point::new(
+            (1.0 - alpha) * u[0].x + beta * u[0].y,
+            (1.0 - alpha) * u[0].y - beta * u[0].x,
+        );
+        let q = Point::new(
+            alpha * u[1].x - beta * u[1].y,
+            alpha * u[1].y + beta * u[1].x,
+        );
+        push_roots(&mut critical, 0.0, cross(u[2], q), cross(u[2], p));
+    }
+    for f in &functions.0 {
+        // f = ss·s² + (rs·r + s1)·s + (rr·r² + r1·r + c).
+        push_roots(&mut critical, 0.0, f.rs, f.s); // parallel line: the s-coefficient vanishes
+        push_roots(&mut critical, f.rr, f.r, f.c); // camera on the boundary
+        push_roots(&mut critical, f.rr, f.r + f.rs, f.c + f.s + f.ss); // s = 1
+        push_roots(&mut critical, f.rr + f.rs + f.ss, f.r + f.s, f.c); // s = r
+                                                                       // Discriminant (rs·r + s1)² − 4·ss·(rr·r² + r1·r + c) = 0.
+        push_roots(
+            &mut critical,
+            f.rs * f.rs - 4.0 * f.ss * f.rr,
+            2.0 * f.rs * f.s - 4.0 * f.ss * f.r,
+            f.s * f.s - 4.0 * f.ss * f.c,
+        );
+    }
+    critical
 }
 
 /// Midpoints of the gaps between the sorted `points` inside `(lo, hi)`, plus a point inside
@@ -142,14 +148,26 @@ fn gap_samples(points: &mut Vec<f64>, lo: f64, hi: f64, scale: f64) -> Vec<f64> 
             return Vec::new();
         }
     }
-    let mut samples: Vec<f64> = cuts.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+    let mut samples: Vec<f64> = cuts.windows(2).map(|w| inside(w[0], w[1])).collect();
     let last = *cuts.last().expect("lo is a cut");
     samples.push(if hi.is_finite() {
-        0.5 * (last + hi)
+        inside(last, hi)
     } else {
         2.0 * last.max(1.0)
     });
     samples
+}
+
+/// A point well inside `(a, b)`. Across orders of magnitude, the point nearest to 1 that stays
+/// a factor 2 from both ends: the landmarks' ranges are then of comparable size, and a gap that
+/// ends at a huge (often spurious) critical value is not sampled where the nearer landmarks
+/// vanish in rounding.
+fn inside(a: f64, b: f64) -> f64 {
+    if a > 0.0 && b > 4.0 * a {
+        1.0f64.clamp(2.0 * a, 0.5 * b)
+    } else {
+        0.5 * (a + b)
+    }
 }
 
 /// Appends the positive real roots of `a·x² + b·x + c` (a linear or constant polynomial when

@@ -11,6 +11,7 @@
 //! arrangement is lost however different the ranges are.) With exact bearings this is the
 //! paper's two-unknown problem; each uncertain bearing adds one unknown.
 
+use super::interval::by_intervals;
 use super::sweep::sweep_regions;
 use super::Bearing;
 use crate::calculus::{Calculus, RelationSet};
@@ -24,14 +25,14 @@ pub type TripleRelations = [RelationSet; 3];
 
 /// The EDC regions of `AB:C`, `BC:A`, `CA:B` (in that order) consistent with the bearings of
 /// `A`, `B`, `C` and the ordered pairs `nearer` (`(p, q)`: landmark `p` of the triple is nearer
-/// than `q`), restricted to `candidates`. Undecided regions are kept (soundness). `None` when
+/// than `q`), restricted to `candidates`: by [`by_sweep`] for exact bearings, otherwise the
+/// regions reached at the nominal bearings plus those [`by_intervals`] cannot rule out. `None` when
 /// the bearings are exact and collinear: every arrangement then lies on the line AB, where no
 /// EDC region is defined, and nothing is learnt.
 pub fn measure_triple_edc(
     bearings: [Bearing; 3],
     nearer: &[(usize, usize)],
     candidates: TripleRelations,
-    engine: &BranchAndBound,
 ) -> Option<TripleRelations> {
     if all_collinear(&bearings) {
         return None;
@@ -48,10 +49,11 @@ pub fn measure_triple_edc(
             .intersection(tables.left(candidates[1]))
             .intersection(tables.right(candidates[0])),
     ];
+    let nominal = by_sweep(bearings.map(|b| Bearing::exact(b.angle)), nearer, candidates);
     Some(if bearings.iter().all(|b| b.uncertainty == 0.0) {
-        by_sweep(bearings, nearer, candidates)
+        nominal
     } else {
-        by_search(bearings, nearer, candidates, engine)
+        by_intervals(bearings, nearer, candidates, nominal)
     })
 }
 
