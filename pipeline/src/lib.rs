@@ -10,3 +10,6 @@ pub mod generation;
 pub mod geometry;
 pub mod map;
 pub mod measurement;
+pub mod metrics;
+pub mod neighborhood;
+pub mod simulation;

@@ -9,6 +9,9 @@ use qrm::fdc::Fdc;
 use qrm::geometry::{boundary_values, Point};
 use std::process::ExitCode;
 
+mod cli;
+use cli::CalculusName;
+
 #[derive(Parser, Debug)]
 #[command(
     name = "pipeline",
@@ -21,12 +24,6 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum CalculusName {
-    Edc,
-    Fdc,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -68,6 +65,12 @@ enum Command {
     },
     /// Statistics of the committed operator tables.
     Tables,
+    /// Measure one triple from bearings (degrees) and a range order (000 §IV), e.g.
+    /// `measure 0 40 100 --order "A<B<C" --uncertainty 0.5`.
+    Measure(cli::measure::MeasureArgs),
+    /// Simulated mapping with ground truth: Monte Carlo studies (000 Fig. 7), single maps.
+    #[command(subcommand)]
+    Simulate(cli::simulate::SimulateCommand),
 }
 
 fn parse_point(text: &str) -> Result<Point> {
@@ -194,6 +197,8 @@ fn run(cli: Cli) -> Result<()> {
             println!("{}", t.unary(op, s));
         }
         Command::Tables => table_stats(),
+        Command::Measure(args) => cli::measure::run(args)?,
+        Command::Simulate(command) => cli::simulate::run_command(command)?,
     }
     Ok(())
 }

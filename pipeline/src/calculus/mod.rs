@@ -38,6 +38,12 @@ pub trait Calculus: Send + Sync + 'static {
     /// touches a line also reaches a cell beside it.
     fn from_edc(regions: RelationSet) -> RelationSet;
 
+    /// The relations of `AB:C` that put C in the lune of A and B (inside both circles), if the
+    /// calculus can tell: what the RNG estimate of 000 §VII-A needs.
+    fn lune() -> Option<RelationSet> {
+        None
+    }
+
     /// The EDC regions a measurement must test when `open` relations are still possible.
     fn edc_candidates(open: RelationSet) -> RelationSet {
         RelationSet::from_relations((1..=crate::edc::REGIONS).filter(|&r| {

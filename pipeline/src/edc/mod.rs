@@ -34,6 +34,10 @@ impl Calculus for Edc {
         regions
     }
 
+    fn lune() -> Option<RelationSet> {
+        Some(RelationSet::from_relations(LUNE))
+    }
+
     fn tables() -> &'static OperatorTables {
         static TABLES: OnceLock<OperatorTables> = OnceLock::new();
         TABLES.get_or_init(|| {

@@ -1,0 +1,36 @@
+//! Subcommands of the `pipeline` binary beyond the calculus tools in `main.rs`.
+
+pub mod measure;
+pub mod output;
+pub mod simulate;
+
+use clap::ValueEnum;
+use qrm::calculus::Calculus;
+use qrm::map::Hypergraph;
+use qrm::neighborhood::RngEstimate;
+use serde_json::json;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum CalculusName {
+    Edc,
+    Fdc,
+}
+
+/// The RNG estimate as JSON (format in docs/MAP_FORMAT.md).
+pub fn rng_json<C: Calculus>(map: &Hypergraph<C>, rng: &RngEstimate) -> String {
+    let edges: Vec<_> = rng
+        .edges
+        .iter()
+        .map(|e| json!({"a": e.a, "b": e.b, "cost": e.cost}))
+        .collect();
+    let value = json!({
+        "format": "qrm-rng",
+        "version": 1,
+        "calculus": C::NAME,
+        "landmarks": map.landmarks(),
+        "pruned": rng.pruned,
+        "total_cost": rng.total_cost(),
+        "edges": edges,
+    });
+    serde_json::to_string_pretty(&value).expect("JSON values serialise") + "\n"
+}

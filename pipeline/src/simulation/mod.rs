@@ -1,0 +1,13 @@
+//! Simulated mapping with ground truth (000 §VIII-B; 003 §1.5.2): landmark fields, a camera
+//! model that measures from true geometry, mapping runs scored after every image, and the
+//! Monte Carlo study of Fig. 7.
+
+mod mapping;
+mod montecarlo;
+mod scenario;
+mod sensor;
+
+pub use mapping::{observations, run, Step};
+pub use montecarlo::{MonteCarlo, MonteCarloResult, Series, Statistic};
+pub use scenario::Scenario;
+pub use sensor::Sensor;
