@@ -78,10 +78,9 @@ fn violations<C: Calculus>(count: usize, delta: f64, seed: u64) -> usize {
                 let Some(truth) = true_relations::<C>(&scene.landmarks) else {
                     continue;
                 };
-                let measured =
-                    scene
-                        .panorama
-                        .measure_triple::<C>([0, 1, 2], [C::universe(); 3]);
+                let measured = scene
+                    .panorama
+                    .measure_triple::<C>([0, 1, 2], [C::universe(); 3]);
                 if (0..3).any(|k| !measured[k].contains(truth[k])) {
                     eprintln!(
                         "violation: {:?} {:?} truth {truth:?} measured {:?}",
@@ -99,17 +98,107 @@ fn violations<C: Calculus>(count: usize, delta: f64, seed: u64) -> usize {
 
 #[test]
 fn exact_bearings_never_exclude_the_true_region() {
-    assert_eq!(violations::<Edc>(400_000, 0.0, 1), 0);
+    assert_eq!(violations::<Edc>(700_000, 0.0, 1), 0);
 }
 
 #[test]
 fn uncertain_bearings_never_exclude_the_true_region() {
-    assert_eq!(violations::<Edc>(100_000, 0.02, 2), 0);
-    assert_eq!(violations::<Edc>(20_000, 0.2, 3), 0);
+    assert_eq!(violations::<Edc>(200_000, 0.005, 2), 0);
+    assert_eq!(violations::<Edc>(80_000, 0.05, 3), 0);
+    assert_eq!(violations::<Edc>(20_000, 0.3, 6), 0);
+}
+
+/// Everything that arrangements sampled from the observation reach (bearings inside their
+/// intervals, ranges in the order) must be in the measured set: a lower bound of the feasible
+/// set, drawn independently of the measurement code.
+fn sampled_lower_bound_is_contained(delta: f64, scenes: usize, samples: usize, seed: u64) {
+    let mut rng = rng(seed);
+    for _ in 0..scenes {
+        let scene = random_scene(&mut rng, delta);
+        let panorama = &scene.panorama;
+        let measured = panorama.measure_triple::<Edc>([0, 1, 2], [Edc::universe(); 3]);
+        let mut reached = [RelationSet::EMPTY; 3];
+        for _ in 0..samples {
+            let ranges: [f64; 3] = std::array::from_fn(|_| 10f64.powf(rng.random_range(-2.0..2.0)));
+            let consistent = (0..3)
+                .all(|i| (0..3).all(|j| !panorama.order.is_nearer(i, j) || ranges[i] < ranges[j]));
+            if !consistent {
+                continue;
+            }
+            let p: [Point; 3] = std::array::from_fn(|i| {
+                let b = panorama.bearings[i];
+                let angle = if delta > 0.0 {
+                    b.angle + rng.random_range(-delta..=delta)
+                } else {
+                    b.angle
+                };
+                Point::new(ranges[i] * angle.cos(), ranges[i] * angle.sin())
+            });
+            if let Some(t) = true_relations::<Edc>(&p) {
+                for k in 0..3 {
+                    reached[k] = reached[k].with(t[k]);
+                }
+            }
+        }
+        for k in 0..3 {
+            assert!(
+                reached[k].is_subset(measured[k]),
+                "relation {k}: sampled {} not within measured {} for {:?}",
+                reached[k],
+                measured[k],
+                panorama
+            );
+        }
+    }
+}
+
+#[test]
+fn sampled_arrangements_stay_inside_the_measurement() {
+    sampled_lower_bound_is_contained(0.0, 400, 4000, 11);
+    sampled_lower_bound_is_contained(0.03, 100, 4000, 12);
 }
 
 #[test]
 fn fdc_measurement_is_sound() {
     assert_eq!(violations::<Fdc>(100_000, 0.0, 4), 0);
     assert_eq!(violations::<Fdc>(20_000, 0.05, 5), 0);
+}
+
+/// The sweep against the branch-and-bound search, an independent decision procedure: every
+/// region the search proves feasible (with a checked witness) is in the sweep's result, and the
+/// sweep adds almost nothing the search refutes.
+#[test]
+fn sweep_agrees_with_branch_and_bound() {
+    use qrm::feasibility::BranchAndBound;
+    use qrm::measurement::{by_search, by_sweep};
+    let engine = BranchAndBound::default();
+    let mut rng = rng(21);
+    let (mut relations, mut extra) = (0, 0);
+    for _ in 0..150 {
+        let bearings: [Bearing; 3] =
+            std::array::from_fn(|_| Bearing::exact(rng.random_range(-3.2..3.2)));
+        let pairs: Vec<(usize, usize)> = [(0, 1), (1, 2), (0, 2)]
+            .into_iter()
+            .filter(|_| rng.random_bool(0.6))
+            .collect();
+        let nearer = RangeOrder::from_pairs(3, &pairs)
+            .unwrap()
+            .restricted(&[0, 1, 2]);
+        let sweep = by_sweep(bearings, &nearer, [Edc::universe(); 3]);
+        let search = by_search(bearings, &nearer, [Edc::universe(); 3], &engine);
+        for k in 0..3 {
+            relations += 1;
+            assert!(
+                search[k].is_subset(sweep[k]),
+                "{bearings:?} {nearer:?}: search {} sweep {}",
+                search[k],
+                sweep[k]
+            );
+            extra += usize::from(!sweep[k].is_subset(search[k]));
+        }
+    }
+    assert!(
+        extra * 100 <= relations,
+        "{extra} of {relations} relations looser"
+    );
 }

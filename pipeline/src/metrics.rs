@@ -4,10 +4,9 @@
 //! `total_landmarks` (Fig. 7a: "percentage of the total number of possible incorrect states for
 //! 30 landmarks"), so landmarks not yet observed count as unresolved.
 
-use crate::calculus::{Calculus, RelationSet};
-use crate::edc::{adjacency, Edc};
+use crate::calculus::Calculus;
+use crate::edc::{Edc, ADJACENT};
 use crate::map::{Hypergraph, LandmarkId};
-use std::sync::OnceLock;
 
 /// One evaluation of a map.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -40,7 +39,6 @@ pub fn evaluate<C: Calculus>(
     let universe = C::universe();
     let states = universe.len() as f64;
     let final_triples = choose3(total_landmarks.max(map.len()));
-    let adjacent = edc_adjacency();
     let mut removed_incorrect = 0usize;
     let mut open_states = 0usize;
     let mut open_total = 0usize;
@@ -73,7 +71,7 @@ pub fn evaluate<C: Calculus>(
             removed_incorrect += universe.len() - set.len();
             open_total += set.len();
             if C::NAME == Edc::NAME {
-                let near = adjacent[t as usize - 1].with(t);
+                let near = ADJACENT[t as usize - 1].with(t);
                 non_adjacent += set.difference(near).len();
             }
         }
@@ -90,12 +88,6 @@ pub fn evaluate<C: Calculus>(
         out.non_adjacent_open_pct = 100.0 * non_adjacent as f64 / open_total as f64;
     }
     out
-}
-
-/// Regions adjacent to each EDC region (computed once from the geometry).
-fn edc_adjacency() -> &'static [RelationSet] {
-    static ADJACENT: OnceLock<Vec<RelationSet>> = OnceLock::new();
-    ADJACENT.get_or_init(adjacency)
 }
 
 #[cfg(test)]

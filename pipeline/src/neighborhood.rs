@@ -78,12 +78,12 @@ pub fn true_rng(points: &[Point]) -> Vec<(usize, usize)> {
     let mut edges = Vec::new();
     for i in 0..n {
         for j in i + 1..n {
-            let d = points[i].distance(points[j]);
+            let d = squared_distance(points[i], points[j]);
             let blocked = (0..n).any(|k| {
                 k != i
                     && k != j
-                    && points[k].distance(points[i]) < d
-                    && points[k].distance(points[j]) < d
+                    && squared_distance(points[k], points[i]) < d
+                    && squared_distance(points[k], points[j]) < d
             });
             if !blocked {
                 edges.push((i, j));
@@ -91,6 +91,10 @@ pub fn true_rng(points: &[Point]) -> Vec<(usize, usize)> {
         }
     }
     edges
+}
+
+fn squared_distance(p: Point, q: Point) -> f64 {
+    (p.x - q.x).powi(2) + (p.y - q.y).powi(2)
 }
 
 /// How an estimate compares with the true RNG of the same landmarks.
@@ -111,7 +115,8 @@ pub struct RngComparison {
 impl RngComparison {
     /// Fraction of surviving edges that are true edges.
     pub fn precision(&self) -> f64 {
-        let kept = self.certain_true + self.certain_false + self.uncertain_true + self.uncertain_false;
+        let kept =
+            self.certain_true + self.certain_false + self.uncertain_true + self.uncertain_false;
         if kept == 0 {
             1.0
         } else {
@@ -185,8 +190,12 @@ mod tests {
             for b in 0..5u32 {
                 for c in 0..5u32 {
                     if a != b && b != c && a != c {
-                        let r = Edc::classify(points[a as usize], points[b as usize], points[c as usize])
-                            .expect("generic points");
+                        let r = Edc::classify(
+                            points[a as usize],
+                            points[b as usize],
+                            points[c as usize],
+                        )
+                        .expect("generic points");
                         observations.push(Observation::new(a, b, c, RelationSet::single(r)));
                     }
                 }

@@ -199,8 +199,8 @@ fn summary(result: &MonteCarloResult, seconds: f64) -> String {
     for series in &result.series {
         let last = series.seconds.len() - 1;
         let at10 = 9.min(last);
-        let mean_ms = 1e3 * series.seconds.iter().map(|x| x.mean).sum::<f64>()
-            / series.seconds.len() as f64;
+        let mean_ms =
+            1e3 * series.seconds.iter().map(|x| x.mean).sum::<f64>() / series.seconds.len() as f64;
         let _ = writeln!(
             out,
             "{:>6} {:>10.1} {:>10.1} {:>11.1} {:>10.1} {:>10.1} {:>10.1} {:>11.3} {:>9.3} {:>9.3} {:>8.2} {:>8}",
@@ -286,7 +286,15 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
         last.metrics.unsound_relations,
         steps.iter().filter(|s| s.contradiction).count()
     );
-    println!("wrote {}/steps.csv, map.json{}", args.out.display(), if C::lune().is_some() { ", rng.json" } else { "" });
+    println!(
+        "wrote {}/steps.csv, map.json{}",
+        args.out.display(),
+        if C::lune().is_some() {
+            ", rng.json"
+        } else {
+            ""
+        }
+    );
     Ok(())
 }
 
@@ -296,12 +304,26 @@ fn basic<C: Calculus>(seed: u64) -> Result<()> {
     let scenario = Scenario::random(seed, 4, 0, 100.0);
     let sensor = Sensor::exact(None);
     let candidates: Vec<Point> = (0..40)
-        .flat_map(|i| (0..40).map(move |j| Point::new(2.5 * i as f64 + 1.25, 2.5 * j as f64 + 1.25)))
+        .flat_map(|i| {
+            (0..40).map(move |j| Point::new(2.5 * i as f64 + 1.25, 2.5 * j as f64 + 1.25))
+        })
         .collect();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let mut map = Hypergraph::<C>::new();
-    let open = |m: &Hypergraph<C>| m.triples().map(|t| t.3.iter().map(|s| s.len()).sum::<usize>()).sum::<usize>();
-    println!("{} map of 4 landmarks {:?}", C::NAME, scenario.landmarks.iter().map(|p| (p.x.round(), p.y.round())).collect::<Vec<_>>());
+    let open = |m: &Hypergraph<C>| {
+        m.triples()
+            .map(|t| t.3.iter().map(|s| s.len()).sum::<usize>())
+            .sum::<usize>()
+    };
+    println!(
+        "{} map of 4 landmarks {:?}",
+        C::NAME,
+        scenario
+            .landmarks
+            .iter()
+            .map(|p| (p.x.round(), p.y.round()))
+            .collect::<Vec<_>>()
+    );
     for image in 1..=7 {
         let best = candidates
             .iter()
@@ -314,13 +336,22 @@ fn basic<C: Calculus>(seed: u64) -> Result<()> {
             .min_by_key(|(open, _, _)| *open)
             .expect("candidates");
         map = best.2;
-        let full = map.triples().filter(|t| t.3.iter().all(|s| s.len() == 1)).count();
+        let full = map
+            .triples()
+            .filter(|t| t.3.iter().all(|s| s.len() == 1))
+            .count();
         println!(
             "image {image} at ({:.1}, {:.1}): {} open states in {} triples, {} fully constrained",
-            best.1.x, best.1.y, best.0, map.triple_count(), full
+            best.1.x,
+            best.1.y,
+            best.0,
+            map.triple_count(),
+            full
         );
         if full == map.triple_count() {
-            println!("fully constrained after {image} images (003 Fig. 1.6a: 7 hand-picked images)");
+            println!(
+                "fully constrained after {image} images (003 Fig. 1.6a: 7 hand-picked images)"
+            );
             break;
         }
     }
@@ -330,9 +361,11 @@ fn basic<C: Calculus>(seed: u64) -> Result<()> {
 fn progress(len: u64, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len);
     bar.set_style(
-        ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {pos}/{len} ({elapsed}, eta {eta})")
-            .expect("static template")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "{spinner} {msg} [{bar:40}] {pos}/{len} ({elapsed}, eta {eta})",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
     );
     bar.set_message(what.to_string());
     bar

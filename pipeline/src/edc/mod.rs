@@ -4,7 +4,7 @@ mod adjacency;
 mod constraints;
 mod region;
 
-pub use adjacency::adjacency;
+pub use adjacency::{adjacency, ADJACENT};
 pub use constraints::{fixed_point, free_point, region_constraints};
 pub use region::{
     classify, defining_boundaries, is_left, mirror, region_of_signs, LUNE, REGIONS, SIGNS,

@@ -33,7 +33,12 @@ impl Interval {
     }
 
     fn scale(self, k: Interval) -> Interval {
-        let p = [self.lo * k.lo, self.lo * k.hi, self.hi * k.lo, self.hi * k.hi];
+        let p = [
+            self.lo * k.lo,
+            self.lo * k.hi,
+            self.hi * k.lo,
+            self.hi * k.hi,
+        ];
         Interval::new(
             p.iter().copied().fold(f64::INFINITY, f64::min),
             p.iter().copied().fold(f64::NEG_INFINITY, f64::max),
@@ -115,10 +120,7 @@ pub fn by_intervals(
         }
         let rc = Interval::new(rc.lo.max(0.0), rc.hi);
         let ranges = [ra, rb, rc];
-        if nearer
-            .iter()
-            .any(|&(p, q)| ranges[p].lo >= ranges[q].hi)
-        {
+        if nearer.iter().any(|&(p, q)| ranges[p].lo >= ranges[q].hi) {
             continue;
         }
         let points: [Point2<Interval>; 3] = std::array::from_fn(|i| {
@@ -145,9 +147,15 @@ pub fn by_intervals(
             let (ma, mb) = (0.5 * (ra.lo + ra.hi), 0.5 * (rb.lo + rb.hi));
             let split_a = ra.hi - ra.lo >= rb.hi - rb.lo;
             let halves = if split_a {
-                [(Interval::new(ra.lo, ma), rb), (Interval::new(ma, ra.hi), rb)]
+                [
+                    (Interval::new(ra.lo, ma), rb),
+                    (Interval::new(ma, ra.hi), rb),
+                ]
             } else {
-                [(ra, Interval::new(rb.lo, mb)), (ra, Interval::new(mb, rb.hi))]
+                [
+                    (ra, Interval::new(rb.lo, mb)),
+                    (ra, Interval::new(mb, rb.hi)),
+                ]
             };
             for (a, b) in halves {
                 stack.push((a, b, depth + 1));

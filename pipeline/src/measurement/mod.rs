@@ -11,8 +11,8 @@ mod range_order;
 mod sweep;
 mod triple;
 
-pub use range_order::{RangeOrder, RangeOrderError};
 pub use interval::by_intervals;
+pub use range_order::{RangeOrder, RangeOrderError};
 pub use sweep::sweep_regions;
 pub use triple::{by_search, by_sweep, measure_triple_edc, TripleRelations};
 

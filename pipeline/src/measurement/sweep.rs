@@ -57,42 +57,66 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
     let r_lo = if is_nearer(0, 1) { 1.0 } else { 0.0 };
     let r_hi = if is_nearer(1, 0) { 1.0 } else { f64::INFINITY };
 
-    let mut critical = critical_ranges(u, &functions);
-    let samples_r = gap_samples(&mut critical, r_lo, r_hi, 0.0);
-
+    // A few typical ranges first: when every wanted region shows up there (the usual case once
+    // the map is tight), the critical values are never needed.
     let mut found = RelationSet::EMPTY;
     let mut roots = Vec::with_capacity(16);
-    for r in samples_r {
-        // Allowed s: C vs A (s vs 1) and C vs B (s vs r).
-        let mut s_lo: f64 = 0.0;
-        let mut s_hi = f64::INFINITY;
-        if is_nearer(0, 2) {
-            s_lo = s_lo.max(1.0);
+    for r in PROBE_RANGES {
+        if r > r_lo && r < r_hi {
+            found = found.union(regions_along_ray(&functions, nearer, r, &mut roots));
         }
-        if is_nearer(2, 0) {
-            s_hi = s_hi.min(1.0);
-        }
-        if is_nearer(1, 2) {
-            s_lo = s_lo.max(r);
-        }
-        if is_nearer(2, 1) {
-            s_hi = s_hi.min(r);
-        }
-        if s_lo >= s_hi {
-            continue;
-        }
-        roots.clear();
-        for f in &functions.0 {
-            push_roots(&mut roots, f.ss, f.rs * r + f.s, (f.rr * r + f.r) * r + f.c);
-        }
-        for s in gap_samples(&mut roots, s_lo, s_hi, r.min(1.0)) {
-            found = found.union(functions.regions_at(r, s));
-        }
+    }
+    if wanted.is_subset(found) {
+        return wanted;
+    }
+    let mut critical = critical_ranges(u, &functions);
+    for r in gap_samples(&mut critical, r_lo, r_hi, 0.0) {
+        found = found.union(regions_along_ray(&functions, nearer, r, &mut roots));
         if wanted.is_subset(found) {
             break;
         }
     }
     found.intersection(wanted)
+}
+
+/// Ratios `|B| / |A|` tried before the exact sweep.
+const PROBE_RANGES: [f64; 6] = [0.3, 0.6, 0.9, 1.1, 1.6, 3.0];
+
+/// The regions C meets on its ray (within the allowed ranges) when `|B| = r·|A|`.
+fn regions_along_ray(
+    functions: &BoundaryPolynomials,
+    nearer: &[(usize, usize)],
+    r: f64,
+    roots: &mut Vec<f64>,
+) -> RelationSet {
+    let is_nearer = |p: usize, q: usize| nearer.contains(&(p, q));
+    // Allowed s: C vs A (s vs 1) and C vs B (s vs r).
+    let mut s_lo: f64 = 0.0;
+    let mut s_hi = f64::INFINITY;
+    if is_nearer(0, 2) {
+        s_lo = s_lo.max(1.0);
+    }
+    if is_nearer(2, 0) {
+        s_hi = s_hi.min(1.0);
+    }
+    if is_nearer(1, 2) {
+        s_lo = s_lo.max(r);
+    }
+    if is_nearer(2, 1) {
+        s_hi = s_hi.min(r);
+    }
+    let mut found = RelationSet::EMPTY;
+    if s_lo >= s_hi {
+        return found;
+    }
+    roots.clear();
+    for f in &functions.0 {
+        push_roots(roots, f.ss, f.rs * r + f.s, (f.rr * r + f.r) * r + f.c);
+    }
+    for s in gap_samples(roots, s_lo, s_hi, r.min(1.0)) {
+        found = found.union(functions.regions_at(r, s));
+    }
+    found
 }
 
 /// The values of `r` at which the sequence of regions along C's ray can change (module doc).
@@ -179,7 +203,7 @@ fn push_roots(out: &mut Vec<f64>, a: f64, b: f64, c: f64) {
     }
     let (a, b, c) = (a / scale, b / scale, c / scale);
     if a.abs() < 1e-14 {
-        if b.abs() > 1e-14 {
+        if b.abs() > 1e-14 && (c / b).is_finite() {
             out.push(-c / b);
         }
         return;
@@ -195,13 +219,8 @@ fn push_roots(out: &mut Vec<f64>, a: f64, b: f64, c: f64) {
     }
     // Numerically stable pair of roots.
     let q = -0.5 * (b + b.signum() * disc.sqrt());
-    if q != 0.0 {
-        out.push(q / a);
-        out.push(c / q);
-    } else {
-        out.push(0.0);
-    }
-    out.retain(|x| x.is_finite());
+    let roots = if q != 0.0 { [q / a, c / q] } else { [0.0, 0.0] };
+    out.extend(roots.into_iter().filter(|x| x.is_finite()));
 }
 
 fn cross(u: Point, v: Point) -> f64 {
@@ -340,19 +359,21 @@ impl BoundaryPolynomials {
     /// within rounding of zero matching either sign.
     fn regions_at(&self, r: f64, s: f64) -> RelationSet {
         let mut signs = [0i8; 6];
-        let mut ambiguous = Vec::new();
+        let mut ambiguous = [0usize; 6];
+        let mut count = 0;
         for (i, f) in self.0.iter().enumerate() {
             let (value, scale) = f.eval(r, s);
             if value.abs() <= ZERO_TOLERANCE * scale {
-                ambiguous.push(i);
+                ambiguous[count] = i;
+                count += 1;
                 signs[i] = 1;
             } else {
                 signs[i] = if value > 0.0 { 1 } else { -1 };
             }
         }
         let mut out = RelationSet::EMPTY;
-        for pattern in 0u32..1 << ambiguous.len() {
-            for (bit, &i) in ambiguous.iter().enumerate() {
+        for pattern in 0u32..1 << count {
+            for (bit, &i) in ambiguous[..count].iter().enumerate() {
                 signs[i] = if pattern >> bit & 1 == 1 { 1 } else { -1 };
             }
             if let Some(region) = region_of_signs(signs) {

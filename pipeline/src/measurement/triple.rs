@@ -49,7 +49,11 @@ pub fn measure_triple_edc(
             .intersection(tables.left(candidates[1]))
             .intersection(tables.right(candidates[0])),
     ];
-    let nominal = by_sweep(bearings.map(|b| Bearing::exact(b.angle)), nearer, candidates);
+    let nominal = by_sweep(
+        bearings.map(|b| Bearing::exact(b.angle)),
+        nearer,
+        candidates,
+    );
     Some(if bearings.iter().all(|b| b.uncertainty == 0.0) {
         nominal
     } else {

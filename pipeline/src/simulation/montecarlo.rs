@@ -168,7 +168,12 @@ impl Series {
                 .sum(),
             unsound_relations: runs
                 .iter()
-                .map(|r| r.iter().map(|s| s.metrics.unsound_relations).max().unwrap_or(0))
+                .map(|r| {
+                    r.iter()
+                        .map(|s| s.metrics.unsound_relations)
+                        .max()
+                        .unwrap_or(0)
+                })
                 .sum(),
         }
     }

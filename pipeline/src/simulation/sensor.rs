@@ -70,6 +70,9 @@ impl Sensor {
             .collect();
         let order = RangeOrder::total(&nearest_first).expect("a permutation is a chain");
         let panorama = Panorama::new(bearings, order).expect("simulated bearings are valid");
-        (by_range.iter().map(|&i| i as LandmarkId).collect(), panorama)
+        (
+            by_range.iter().map(|&i| i as LandmarkId).collect(),
+            panorama,
+        )
     }
 }
