@@ -1,5 +1,6 @@
 //! `pipeline`: the qrm command line. Until the vision front end lands, it exposes the calculus
-//! core: classification, the operators, table statistics and a demo of 000 §III-C.
+//! core (classification, the operators, table statistics, a demo of 000 §III-C), measurement of
+//! single triples, simulated mapping and map files.
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -71,6 +72,9 @@ enum Command {
     /// Simulated mapping with ground truth: Monte Carlo studies (000 Fig. 7), single maps.
     #[command(subcommand)]
     Simulate(cli::simulate::SimulateCommand),
+    /// Inspect or merge saved maps (JSON, docs/MAP_FORMAT.md).
+    #[command(subcommand)]
+    Map(cli::map::MapCommand),
 }
 
 fn parse_point(text: &str) -> Result<Point> {
@@ -199,6 +203,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Tables => table_stats(),
         Command::Measure(args) => cli::measure::run(args)?,
         Command::Simulate(command) => cli::simulate::run_command(command)?,
+        Command::Map(command) => cli::map::run_command(command)?,
     }
     Ok(())
 }

@@ -72,3 +72,73 @@ fn bad_input_is_a_clear_error() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn measures_a_triple() {
+    let o = run(&["measure", "0", "40", "100", "--order", "A<B<C"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = stdout(&o);
+    assert!(text.starts_with("AB:C = {1,2,5}"), "{text}");
+    assert_eq!(text.lines().count(), 6);
+    let wide = stdout(&run(&[
+        "measure",
+        "0",
+        "40",
+        "100",
+        "--order",
+        "A<B<C",
+        "--uncertainty",
+        "1",
+    ]));
+    // A bearing interval can only add regions.
+    let first = |t: &str| t.lines().next().unwrap().to_string();
+    assert!(first(&wide).contains("1,2,5"), "{wide}");
+    for bad in [
+        vec!["measure", "0", "40", "100", "--order", "A<D"],
+        vec!["measure", "0", "40", "100", "--order", "A<B,B<A"],
+        vec!["measure", "0", "40", "100", "--uncertainty", "60"],
+        vec!["measure", "0", "40", "x"],
+    ] {
+        let o = run(&bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+        assert!(!o.stderr.is_empty(), "{bad:?}");
+    }
+}
+
+#[test]
+fn simulates_and_writes_outputs() {
+    let dir = std::env::temp_dir().join(format!("qrm-cli-sim-{}", std::process::id()));
+    let o = run(&[
+        "simulate",
+        "single",
+        "--landmarks",
+        "8",
+        "--stations",
+        "6",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for file in ["steps.csv", "map.json", "rng.json"] {
+        assert!(dir.join(file).is_file(), "{file}");
+    }
+    let map = std::fs::read_to_string(dir.join("map.json")).unwrap();
+    assert!(qrm::map::Hypergraph::<qrm::edc::Edc>::from_json(&map).is_ok());
+    let o = run(&[
+        "simulate",
+        "montecarlo",
+        "--maps",
+        "2",
+        "--stations",
+        "4",
+        "--nearest",
+        "5,8",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(dir.join("montecarlo.csv").is_file());
+    let o = run(&["simulate", "montecarlo", "--nearest", "2"]);
+    assert_eq!(o.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).ok();
+}

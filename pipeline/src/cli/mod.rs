@@ -1,5 +1,6 @@
 //! Subcommands of the `pipeline` binary beyond the calculus tools in `main.rs`.
 
+pub mod map;
 pub mod measure;
 pub mod output;
 pub mod simulate;
