@@ -10,3 +10,4 @@ pub mod generation;
 pub mod geometry;
 pub mod map;
 pub mod measurement;
+pub mod plot;
