@@ -122,3 +122,62 @@ fn render(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Format;
+    use crate::plot::test_support::{file_names, scratch_dir};
+    use crate::plot::{write_rng, PlotError, RngPicture};
+    use std::path::Path;
+
+    #[test]
+    fn the_extension_names_the_format() {
+        assert_eq!(Format::of(Path::new("a/b.png")).unwrap(), Format::Png);
+        assert_eq!(Format::of(Path::new("b.SVG")).unwrap(), Format::Svg);
+        for bad in ["b.pdf", "b", "png", ".png.txt"] {
+            assert!(
+                Format::of(Path::new(bad)).is_err(),
+                "{bad} should be rejected"
+            );
+        }
+    }
+
+    #[test]
+    fn a_missing_directory_is_an_error_naming_the_file_and_leaves_nothing() {
+        let dir = scratch_dir("output-missing");
+        let picture = RngPicture {
+            title: "t".into(),
+            landmarks: &[(0.0, 0.0), (1.0, 1.0)],
+            edges: &[(0, 1, 0.5)],
+            true_edges: &[],
+            stations: &[],
+        };
+        for name in ["fig.png", "fig.svg"] {
+            let path = dir.join("missing").join(name);
+            let error = write_rng(&path, &picture).unwrap_err();
+            assert!(
+                matches!(error, PlotError::Draw { .. } | PlotError::Io { .. }),
+                "{error}"
+            );
+            assert!(error.to_string().contains(name), "{error}");
+        }
+        assert!(file_names(&dir).is_empty());
+    }
+
+    #[test]
+    fn an_existing_file_is_replaced() {
+        let dir = scratch_dir("output-replace");
+        let path = dir.join("fig.svg");
+        std::fs::write(&path, "old").unwrap();
+        let picture = RngPicture {
+            title: "new".into(),
+            landmarks: &[(0.0, 0.0)],
+            edges: &[],
+            true_edges: &[],
+            stations: &[],
+        };
+        write_rng(&path, &picture).unwrap();
+        assert!(std::fs::read_to_string(&path).unwrap().starts_with("<svg"));
+        assert_eq!(file_names(&dir), ["fig.svg"]);
+    }
+}

@@ -232,3 +232,114 @@ fn draw_panel<DB: DrawingBackend>(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{write_panels, Curve, Panel, SIZE};
+    use crate::plot::test_support::{file_names, png_size, scratch_dir};
+    use crate::plot::PlotError;
+
+    fn curve(label: &str, mean: Vec<f64>) -> Curve {
+        let std = mean.iter().map(|m| 0.1 * m.abs()).collect();
+        Curve {
+            label: label.into(),
+            mean,
+            std,
+        }
+    }
+
+    fn panel(curves: Vec<Curve>) -> Panel {
+        Panel {
+            title: "(a) states removed".into(),
+            y_label: "removed [%]".into(),
+            curves,
+        }
+    }
+
+    fn four_panels() -> Vec<Panel> {
+        let ramp = |n: f64| {
+            (1..=20)
+                .map(|k| 100.0 * (1.0 - (-k as f64 * n / 60.0).exp()))
+                .collect()
+        };
+        (0..4)
+            .map(|_| panel(vec![curve("n = 6", ramp(6.0)), curve("n = 30", ramp(30.0))]))
+            .collect()
+    }
+
+    #[test]
+    fn png_and_svg_are_written_at_the_expected_size() {
+        let dir = scratch_dir("panels");
+        let png = dir.join("fig7.png");
+        let svg = dir.join("fig7.svg");
+        write_panels(&png, "image number", &four_panels()).unwrap();
+        write_panels(&svg, "image number", &four_panels()).unwrap();
+        assert_eq!(png_size(&png), SIZE);
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(
+            text.starts_with("<svg") && text.contains("n = 30"),
+            "{text:.200}"
+        );
+        assert_eq!(file_names(&dir), ["fig7.png", "fig7.svg"]);
+    }
+
+    #[test]
+    fn one_point_curves_and_curves_without_deviation_are_drawn() {
+        let dir = scratch_dir("panels-small");
+        let path = dir.join("small.PNG");
+        let mut alone = curve("n = 9", vec![4.0, 4.0, 4.0]);
+        alone.std.clear();
+        let panels = [panel(vec![curve("n = 6", vec![3.0])]), panel(vec![alone])];
+        write_panels(&path, "image", &panels).unwrap();
+        assert_eq!(png_size(&path), SIZE);
+    }
+
+    #[test]
+    fn bad_extension_is_an_error_naming_the_file() {
+        let dir = scratch_dir("panels-extension");
+        for name in ["fig.jpg", "fig"] {
+            let path = dir.join(name);
+            let error = write_panels(&path, "image", &four_panels()).unwrap_err();
+            assert!(matches!(error, PlotError::Format { .. }), "{error}");
+            assert!(error.to_string().contains(name), "{error}");
+        }
+        assert!(file_names(&dir).is_empty());
+    }
+
+    #[test]
+    fn undrawable_data_is_an_error_and_writes_nothing() {
+        let dir = scratch_dir("panels-data");
+        let path = dir.join("bad.png");
+        let mut short_std = curve("n = 6", vec![1.0, 2.0]);
+        short_std.std.pop();
+        let cases: Vec<(Vec<Panel>, &str)> = vec![
+            (Vec::new(), "no panels"),
+            (vec![panel(vec![curve("n = 6", vec![1.0])]); 5], "at most 4"),
+            (vec![panel(Vec::new())], "no curves"),
+            (vec![panel(vec![curve("n = 6", Vec::new())])], "no values"),
+            (vec![panel(vec![short_std])], "2 means but 1 standard"),
+            (
+                vec![panel(vec![curve("n = 6", vec![1.0, f64::NAN])])],
+                "mean at image 2 is NaN",
+            ),
+            (
+                vec![panel(vec![Curve {
+                    label: "n = 6".into(),
+                    mean: vec![1.0],
+                    std: vec![f64::INFINITY],
+                }])],
+                "standard deviation at image 1 is inf",
+            ),
+        ];
+        for (panels, reason) in cases {
+            let error = write_panels(&path, "image", &panels).unwrap_err();
+            assert!(matches!(error, PlotError::Data { .. }), "{error}");
+            let message = error.to_string();
+            assert!(
+                message.contains("bad.png") && message.contains(reason),
+                "{message}"
+            );
+        }
+        assert!(file_names(&dir).is_empty());
+    }
+}

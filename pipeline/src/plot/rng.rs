@@ -227,3 +227,148 @@ impl Figure for RngPicture<'_> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{equal_aspect, write_rng, RngPicture, SIZE};
+    use crate::plot::test_support::{file_names, png_size, scratch_dir};
+    use crate::plot::PlotError;
+
+    const LANDMARKS: [(f64, f64); 4] = [(0.0, 0.0), (4.0, 0.0), (4.0, 2.0), (0.0, 2.0)];
+    const EDGES: [(usize, usize, f64); 4] = [(0, 1, 0.0), (1, 2, 0.3), (2, 3, 1.0), (0, 2, 0.6)];
+    const TRUE_EDGES: [(usize, usize); 4] = [(0, 1), (1, 2), (2, 3), (3, 0)];
+    const STATIONS: [(f64, f64); 2] = [(1.0, 1.0), (3.0, 1.0)];
+
+    fn picture() -> RngPicture<'static> {
+        RngPicture {
+            title: "after image 2".into(),
+            landmarks: &LANDMARKS,
+            edges: &EDGES,
+            true_edges: &TRUE_EDGES,
+            stations: &STATIONS,
+        }
+    }
+
+    #[test]
+    fn png_and_svg_are_written_at_the_expected_size() {
+        let dir = scratch_dir("rng");
+        let png = dir.join("rng.png");
+        let svg = dir.join("rng.svg");
+        write_rng(&png, &picture()).unwrap();
+        write_rng(&svg, &picture()).unwrap();
+        assert_eq!(png_size(&png), SIZE);
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(
+            text.starts_with("<svg") && text.contains("after image 2"),
+            "{text:.200}"
+        );
+        assert_eq!(file_names(&dir), ["rng.png", "rng.svg"]);
+    }
+
+    #[test]
+    fn a_lone_landmark_without_edges_or_stations_is_drawn() {
+        let dir = scratch_dir("rng-lone");
+        let path = dir.join("lone.png");
+        let lone = RngPicture {
+            title: String::new(),
+            landmarks: &LANDMARKS[..1],
+            edges: &[],
+            true_edges: &[],
+            stations: &[],
+        };
+        write_rng(&path, &lone).unwrap();
+        assert_eq!(png_size(&path), SIZE);
+    }
+
+    #[test]
+    fn undrawable_data_is_an_error_and_writes_nothing() {
+        let dir = scratch_dir("rng-data");
+        let path = dir.join("bad.svg");
+        let nan = [(0.0, 0.0), (f64::NAN, 1.0)];
+        let cases: Vec<(RngPicture, &str)> = vec![
+            (
+                RngPicture {
+                    landmarks: &[],
+                    edges: &[],
+                    true_edges: &[],
+                    ..picture()
+                },
+                "no landmarks",
+            ),
+            (
+                RngPicture {
+                    landmarks: &nan,
+                    edges: &[],
+                    true_edges: &[],
+                    ..picture()
+                },
+                "landmark 1",
+            ),
+            (
+                RngPicture {
+                    stations: &nan,
+                    ..picture()
+                },
+                "imaging point 1",
+            ),
+            (
+                RngPicture {
+                    edges: &[(0, 4, 0.0)],
+                    ..picture()
+                },
+                "names a landmark ≥ 4",
+            ),
+            (
+                RngPicture {
+                    edges: &[(2, 2, 0.0)],
+                    ..picture()
+                },
+                "to itself",
+            ),
+            (
+                RngPicture {
+                    edges: &[(0, 1, f64::NAN)],
+                    ..picture()
+                },
+                "cost NaN",
+            ),
+            (
+                RngPicture {
+                    edges: &[(0, 1, 1.5)],
+                    ..picture()
+                },
+                "cost 1.5",
+            ),
+            (
+                RngPicture {
+                    true_edges: &[(9, 0)],
+                    ..picture()
+                },
+                "true RNG edge (9, 0)",
+            ),
+        ];
+        for (bad, reason) in cases {
+            let error = write_rng(&path, &bad).unwrap_err();
+            assert!(matches!(error, PlotError::Data { .. }), "{error}");
+            let message = error.to_string();
+            assert!(
+                message.contains("bad.svg") && message.contains(reason),
+                "{message}"
+            );
+        }
+        let error = write_rng(&dir.join("rng.pdf"), &picture()).unwrap_err();
+        assert!(matches!(error, PlotError::Format { .. }), "{error}");
+        assert!(file_names(&dir).is_empty());
+    }
+
+    #[test]
+    fn both_axes_get_the_same_scale() {
+        let points = LANDMARKS.iter().copied();
+        let (x, y) = equal_aspect(points, (800, 400));
+        let per_pixel = ((x.end - x.start) / 800.0, (y.end - y.start) / 400.0);
+        assert!((per_pixel.0 - per_pixel.1).abs() < 1e-12, "{per_pixel:?}");
+        assert!(x.start < 0.0 && x.end > 4.0 && y.start < 0.0 && y.end > 2.0);
+        let (x, y) = equal_aspect(std::iter::once((3.0, 3.0)), (100, 100));
+        assert!(x.contains(&3.0) && y.contains(&3.0) && x.end - x.start > 0.0);
+    }
+}

@@ -1,14 +1,33 @@
 //! Helpers for the figure tests: a fresh scratch directory per test, and reading the size of
 //! a PNG from its header, which checks the encoder's output without a decoder dependency.
 
+use std::ops::Deref;
 use std::path::{Path, PathBuf};
 
-/// An empty directory under the system temporary directory, unique to this process and test.
-pub(super) fn scratch_dir(test: &str) -> PathBuf {
+/// An empty directory under the system temporary directory, unique to this process and test,
+/// removed when dropped.
+pub(super) struct Scratch(PathBuf);
+
+impl Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        // Best effort: a leftover directory in the temporary directory is harmless.
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A fresh [`Scratch`] directory for `test`.
+pub(super) fn scratch_dir(test: &str) -> Scratch {
     let dir = std::env::temp_dir().join(format!("qrm-plot-{}-{test}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("create scratch directory");
-    dir
+    Scratch(dir)
 }
 
 /// The (width, height) of the PNG at `path`, after checking its signature and that the first

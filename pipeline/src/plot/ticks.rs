@@ -4,16 +4,26 @@
 
 use std::ops::Range;
 
-/// Labels ticks of an axis over `range` with as many decimals as about ten ticks need.
+/// Labels ticks of an axis over `range` with the decimals its tick step needs. plotters
+/// places at most ten ticks on an axis, spaced by 1, 2 or 5 times a power of ten, so the step
+/// exceeds a ninth of the span; the decimals are those of the smallest such step (more
+/// decimals would only add trailing zeros, fewer would print distinct ticks alike).
 pub(super) fn tick_formatter(range: &Range<f64>) -> impl Fn(&f64) -> String {
-    let step = (range.end - range.start).abs() / 10.0;
-    let decimals = if step > 0.0 {
-        (-step.log10()).ceil().max(0.0) as usize
+    let bound = (range.end - range.start).abs() / 11.0;
+    let decimals = if bound > 0.0 && bound.is_finite() {
+        let power = bound.log10().floor();
+        let step_power = if 5.0 * 10f64.powf(power) > bound {
+            power
+        } else {
+            power + 1.0
+        };
+        (-step_power).max(0.0) as usize
     } else {
         0
     };
-    // Adding 0.0 turns a -0.0 tick into 0.0, so that it is not printed as "-0".
-    move |value: &f64| format!("{:.*}", decimals, value + 0.0)
+    let scale = 10f64.powi(decimals as i32);
+    // Rounding first and then adding 0.0 prints a tick at -1e-17 or -0.0 as "0", not "-0".
+    move |value: &f64| format!("{:.*}", decimals, (value * scale).round() / scale + 0.0)
 }
 
 #[cfg(test)]
@@ -25,6 +35,9 @@ mod tests {
         let percent = tick_formatter(&(-5.0..105.0));
         assert_eq!(percent(&100.0), "100");
         assert_eq!(percent(&-0.0), "0");
+        let metres = tick_formatter(&(-0.5..0.5));
+        assert_eq!(metres(&-1e-17), "0.0");
+        assert_eq!(metres(&0.3), "0.3");
         let small = tick_formatter(&(0.0..0.5));
         assert_eq!(small(&0.25), "0.25");
         let unit = tick_formatter(&(0.0..3.0));
