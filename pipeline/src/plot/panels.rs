@@ -101,6 +101,10 @@ fn validate(panels: &[Panel]) -> Result<(), String> {
                 ));
             }
         }
+        let range = y_range(panel);
+        if !(range.end - range.start).is_finite() {
+            return Err(format!("{name}: values too large to plot"));
+        }
     }
     Ok(())
 }
@@ -147,6 +151,8 @@ impl Figure for Panels<'_> {
             })
             .collect();
         let legend_height = legend::height(root, &entries)?;
+        // However many curves there are, the panels keep at least half of the height.
+        let legend_height = legend_height.min(SIZE.1 / 2);
         let (grid, legend_area) = root.split_vertically(SIZE.1 - legend_height);
         legend::draw(&legend_area, &entries)?;
         let layout = match self.panels.len() {
@@ -329,6 +335,10 @@ mod tests {
                     std: vec![f64::INFINITY],
                 }])],
                 "standard deviation at image 1 is inf",
+            ),
+            (
+                vec![panel(vec![curve("n = 6", vec![f64::MAX, -f64::MAX])])],
+                "too large",
             ),
         ];
         for (panels, reason) in cases {

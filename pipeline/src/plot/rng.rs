@@ -94,6 +94,11 @@ fn validate(picture: &RngPicture) -> Result<(), String> {
     for &(i, j) in picture.true_edges {
         check("true RNG edge", i, j)?;
     }
+    let points = picture.landmarks.iter().chain(picture.stations).copied();
+    let (x, y) = equal_aspect(points, (1, 1));
+    if !(x.end - x.start).is_finite() || !(y.end - y.start).is_finite() {
+        return Err("positions too far apart to plot".into());
+    }
     Ok(())
 }
 
@@ -345,6 +350,13 @@ mod tests {
                     ..picture()
                 },
                 "true RNG edge (9, 0)",
+            ),
+            (
+                RngPicture {
+                    stations: &[(f64::MAX, 0.0), (-f64::MAX, 0.0)],
+                    ..picture()
+                },
+                "too far apart",
             ),
         ];
         for (bad, reason) in cases {
