@@ -12,4 +12,5 @@ pub mod map;
 pub mod measurement;
 pub mod metrics;
 pub mod neighborhood;
+pub mod plot;
 pub mod simulation;
