@@ -12,7 +12,10 @@ use qrm::geometry::Point;
 use qrm::map::Hypergraph;
 use qrm::measurement::MAX_BEARING_UNCERTAINTY;
 use qrm::neighborhood::{estimate, true_rng};
-use qrm::simulation::{observations, run, MonteCarlo, MonteCarloResult, Scenario, Sensor};
+use qrm::plot::{write_panels, write_rng, Curve, Panel, RngPicture};
+use qrm::simulation::{
+    observations, run, MonteCarlo, MonteCarloResult, Scenario, Sensor, Series, Statistic,
+};
 use rand::SeedableRng;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -168,9 +171,84 @@ fn montecarlo(args: MonteCarloArgs) -> Result<()> {
     write_atomic(&args.out.join("montecarlo.csv"), result.to_csv().as_bytes())?;
     let summary = summary(&result, elapsed);
     write_atomic(&args.out.join("summary.txt"), summary.as_bytes())?;
+    let panels = montecarlo_panels(&result);
+    for name in ["montecarlo.png", "montecarlo.svg"] {
+        write_panels(&args.out.join(name), "image number", &panels)?;
+    }
     print!("{summary}");
-    println!("wrote {}/montecarlo.csv, summary.txt", args.out.display());
+    println!(
+        "wrote {}/montecarlo.csv, summary.txt, montecarlo.png, montecarlo.svg",
+        args.out.display()
+    );
     Ok(())
+}
+
+/// 000 Fig. 7 (a)–(d) for a calculus with a lune; 003 Fig. 1.6b otherwise.
+fn montecarlo_panels(result: &MonteCarloResult) -> Vec<Panel> {
+    let curves = |pick: &dyn Fn(&Series) -> &Vec<Statistic>, scale: f64, band: bool| {
+        result
+            .series
+            .iter()
+            .map(|s| Curve {
+                label: s.label(),
+                mean: pick(s).iter().map(|x| x.mean * scale).collect(),
+                std: if band {
+                    pick(s).iter().map(|x| x.std * scale).collect()
+                } else {
+                    Vec::new()
+                },
+            })
+            .collect::<Vec<_>>()
+    };
+    let panel = |title: &str, y: &str, curves: Vec<Curve>| Panel {
+        title: title.to_string(),
+        y_label: y.to_string(),
+        curves,
+    };
+    let time = panel(
+        "(d) time per update",
+        "ms",
+        curves(&|s| &s.seconds, 1e3, false),
+    );
+    if result.calculus == Edc::NAME {
+        vec![
+            panel(
+                "(a) incorrect states removed",
+                "% of incorrect states",
+                curves(&|s| &s.removed_incorrect_pct, 1.0, true),
+            ),
+            panel(
+                "(b) open states not adjacent to the true state",
+                "% of open states",
+                curves(&|s| &s.non_adjacent_open_pct, 1.0, true),
+            ),
+            panel(
+                "(c) total RNG edge cost",
+                "sum of w_ij",
+                curves(&|s| &s.rng_cost, 1.0, true),
+            ),
+            time,
+        ]
+    } else {
+        vec![
+            panel(
+                "(a) open states",
+                "% of all states",
+                curves(&|s| &s.open_pct, 1.0, true),
+            ),
+            panel(
+                "(b) fully constrained triples",
+                "% of triples",
+                curves(&|s| &s.fully_constrained_pct, 1.0, true),
+            ),
+            panel(
+                "(c) incorrect states removed",
+                "% of incorrect states",
+                curves(&|s| &s.removed_incorrect_pct, 1.0, true),
+            ),
+            time,
+        ]
+    }
 }
 
 /// The figures the papers comment on, per series.
@@ -265,13 +343,44 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
             &args.out.join("rng.json"),
             super::rng_json(&map, &rng).as_bytes(),
         )?;
-        let truth = true_rng(&scenario.landmarks);
+        let landmarks: Vec<(f64, f64)> = map
+            .landmarks()
+            .iter()
+            .map(|&id| {
+                let p = scenario.landmarks[id as usize];
+                (p.x, p.y)
+            })
+            .collect();
+        let index = |id: u32| {
+            map.landmarks()
+                .iter()
+                .position(|&x| x == id)
+                .expect("map landmark")
+        };
+        let edges: Vec<(usize, usize, f64)> = rng
+            .edges
+            .iter()
+            .map(|e| (index(e.a), index(e.b), e.cost))
+            .collect();
+        let mapped: Vec<Point> = landmarks.iter().map(|&(x, y)| Point::new(x, y)).collect();
+        let true_edges = true_rng(&mapped);
+        let stations: Vec<(f64, f64)> = scenario.stations.iter().map(|p| (p.x, p.y)).collect();
+        write_rng(
+            &args.out.join("rng.png"),
+            &RngPicture {
+                title: format!("RNG estimate after {} images", steps.len()),
+                landmarks: &landmarks,
+                edges: &edges,
+                true_edges: &true_edges,
+                stations: &stations,
+            },
+        )?;
         println!(
             "RNG: {} edges kept ({} certain), {} pruned; true RNG has {} edges",
             rng.edges.len(),
             rng.certain().count(),
             rng.pruned,
-            truth.len()
+            true_edges.len()
         );
     }
     let last = steps.last().expect("at least one station");
@@ -290,7 +399,7 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
         "wrote {}/steps.csv, map.json{}",
         args.out.display(),
         if C::lune().is_some() {
-            ", rng.json"
+            ", rng.json, rng.png"
         } else {
             ""
         }
