@@ -49,8 +49,35 @@ pub const LUNE: [u8; 4] = [7, 8, 13, 14];
 
 /// The region whose sign vector is `signs`, if any.
 pub fn region_of_signs(signs: [i8; 6]) -> Option<u8> {
-    SIGNS.iter().position(|s| *s == signs).map(|i| i as u8 + 1)
+    let index = signs
+        .iter()
+        .enumerate()
+        .fold(0usize, |acc, (i, &s)| acc | (usize::from(s > 0) << i));
+    match REGION_BY_SIGN_BITS[index] {
+        0 => None,
+        r => Some(r),
+    }
 }
+
+/// [`SIGNS`] inverted: bit `i` of the index set when boundary `i` is positive; 0 for sign
+/// vectors that no region has (measurement classifies millions of samples).
+const REGION_BY_SIGN_BITS: [u8; 64] = {
+    let mut table = [0u8; 64];
+    let mut r = 0;
+    while r < SIGNS.len() {
+        let mut index = 0;
+        let mut i = 0;
+        while i < 6 {
+            if SIGNS[r][i] > 0 {
+                index |= 1 << i;
+            }
+            i += 1;
+        }
+        table[index] = r as u8 + 1;
+        r += 1;
+    }
+    table
+};
 
 /// Whether `region` lies left of AB.
 pub fn is_left(region: u8) -> bool {

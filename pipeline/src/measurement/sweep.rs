@@ -64,10 +64,10 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
     for r in PROBE_RANGES {
         if r > r_lo && r < r_hi {
             found = found.union(regions_along_ray(&functions, nearer, r, &mut roots));
+            if wanted.is_subset(found) {
+                return wanted;
+            }
         }
-    }
-    if wanted.is_subset(found) {
-        return wanted;
     }
     let mut critical = critical_ranges(u, &functions);
     for r in gap_samples(&mut critical, r_lo, r_hi, 0.0) {
