@@ -2,7 +2,7 @@
 //! arrangements are never excluded, and everything a dense sample of arrangements consistent
 //! with the observation reaches is in the measured set.
 
-use qrm::calculus::Calculus;
+use qrm::calculus::{Calculus, RelationSet};
 use qrm::edc::Edc;
 use qrm::fdc::Fdc;
 use qrm::geometry::Point;

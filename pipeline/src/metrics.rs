@@ -93,6 +93,7 @@ pub fn evaluate<C: Calculus>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::calculus::RelationSet;
     use crate::geometry::Point;
     use crate::map::Observation;
 
@@ -114,8 +115,10 @@ mod tests {
     fn exact_map_is_fully_resolved() {
         let mut observations = Vec::new();
         for (a, b, c) in [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)] {
-            let r = truth(a, b, c).unwrap();
-            observations.push(Observation::new(a, b, c, RelationSet::single(r)));
+            for (x, y, z) in [(a, b, c), (b, c, a), (c, a, b)] {
+                let r = truth(x, y, z).unwrap();
+                observations.push(Observation::new(x, y, z, RelationSet::single(r)));
+            }
         }
         let mut map = Hypergraph::<Edc>::new();
         map.fuse(&observations).unwrap();
