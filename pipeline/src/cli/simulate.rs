@@ -279,19 +279,27 @@ fn summary(result: &MonteCarloResult, seconds: f64) -> String {
         let at10 = 9.min(last);
         let mean_ms =
             1e3 * series.seconds.iter().map(|x| x.mean).sum::<f64>() / series.seconds.len() as f64;
+        // Adjacency and the RNG are EDC notions (lune, region adjacency).
+        let edc_only = |v: f64, digits: usize| {
+            if result.calculus == Edc::NAME {
+                format!("{v:.digits$}")
+            } else {
+                "-".to_string()
+            }
+        };
         let _ = writeln!(
             out,
-            "{:>6} {:>10.1} {:>10.1} {:>11.1} {:>10.1} {:>10.1} {:>10.1} {:>11.3} {:>9.3} {:>9.3} {:>8.2} {:>8}",
+            "{:>6} {:>10.1} {:>10.1} {:>11.1} {:>10} {:>10.1} {:>10.1} {:>11} {:>9} {:>9} {:>8.2} {:>8}",
             series.label(),
             series.removed_incorrect_pct[0].mean,
             series.removed_incorrect_pct[at10].mean,
             series.removed_incorrect_pct[last].mean,
-            series.non_adjacent_open_pct[last].mean,
+            edc_only(series.non_adjacent_open_pct[last].mean, 1),
             series.fully_constrained_pct[last].mean,
             series.open_pct[last].mean,
-            series.rng_cost[last].mean,
-            series.rng_precision.mean,
-            series.rng_recall.mean,
+            edc_only(series.rng_cost[last].mean, 3),
+            edc_only(series.rng_precision.mean, 3),
+            edc_only(series.rng_recall.mean, 3),
             mean_ms,
             series.unsound_relations
         );
