@@ -165,8 +165,9 @@ fn fdc_measurement_is_sound() {
 }
 
 /// The sweep against the branch-and-bound search, an independent decision procedure: every
-/// region the search proves feasible (with a checked witness) is in the sweep's result, and the
-/// sweep adds almost nothing the search refutes.
+/// region the search keeps is in the sweep's result. The sweep may keep more: slivers thinner
+/// than the search's margin (10⁻⁷), which the sweep samples, and samples that fall on a
+/// boundary in rounding, which it classifies into both neighbours. That looseness stays small.
 #[test]
 fn sweep_agrees_with_branch_and_bound() {
     use qrm::feasibility::BranchAndBound;
@@ -197,8 +198,26 @@ fn sweep_agrees_with_branch_and_bound() {
             extra += usize::from(!sweep[k].is_subset(search[k]));
         }
     }
+    eprintln!("sweep looser than search on {extra} of {relations} relations");
     assert!(
-        extra * 100 <= relations,
+        extra * 100 <= 8 * relations,
         "{extra} of {relations} relations looser"
     );
+}
+
+/// A sliver the sweep once skipped (found in review): with C's bearing 10⁻⁶ rad from A's, C's
+/// ray crosses the cusp between circle B and the perpendicular at A (both through A) in an
+/// interval ~10⁻¹³ wide. `|A| = 1, |B| = 0.1, |C| = 1.00000005540849` is in region 15 (checked
+/// with exact rationals), so 15 must be measured.
+#[test]
+fn narrow_cusp_near_a_is_not_skipped() {
+    let bearings = vec![
+        Bearing::exact(0.0),
+        Bearing::exact(2.5),
+        Bearing::exact(1e-6),
+    ];
+    let order = RangeOrder::from_pairs(3, &[(1, 0), (0, 2)]).unwrap();
+    let panorama = Panorama::new(bearings, order).unwrap();
+    let measured = panorama.measure_triple::<Edc>([0, 1, 2], [Edc::universe(); 3]);
+    assert!(measured[0].contains(15), "AB:C = {}", measured[0]);
 }

@@ -5,7 +5,6 @@
 //! 30 landmarks"), so landmarks not yet observed count as unresolved.
 
 use crate::calculus::Calculus;
-use crate::edc::{Edc, ADJACENT};
 use crate::map::{Hypergraph, LandmarkId};
 
 /// One evaluation of a map.
@@ -13,8 +12,9 @@ use crate::map::{Hypergraph, LandmarkId};
 pub struct MapMetrics {
     /// Incorrect states removed, % of all incorrect states of the final map (Fig. 7a).
     pub removed_incorrect_pct: f64,
-    /// Open states neither true nor adjacent to the true state, % of open states (Fig. 7b;
-    /// EDC only, 0 for other calculi).
+    /// Open states neither true nor adjacent to the true state, % of open states (Fig. 7b),
+    /// over the relations that still hold their true state; 0 for a calculus without an
+    /// adjacency relation ([`Calculus::adjacent`]).
     pub non_adjacent_open_pct: f64,
     /// Triples whose three relations are single states, % of the final map's triples.
     pub fully_constrained_pct: f64,
@@ -70,9 +70,8 @@ pub fn evaluate<C: Calculus>(
             }
             removed_incorrect += universe.len() - set.len();
             open_total += set.len();
-            if C::NAME == Edc::NAME {
-                let near = ADJACENT[t as usize - 1].with(t);
-                non_adjacent += set.difference(near).len();
+            if let Some(adjacent) = C::adjacent(t) {
+                non_adjacent += set.difference(adjacent.with(t)).len();
             }
         }
     }
@@ -94,6 +93,7 @@ pub fn evaluate<C: Calculus>(
 mod tests {
     use super::*;
     use crate::calculus::RelationSet;
+    use crate::edc::Edc;
     use crate::geometry::Point;
     use crate::map::Observation;
 

@@ -44,6 +44,11 @@ pub trait Calculus: Send + Sync + 'static {
         None
     }
 
+    /// The relations sharing a boundary edge or vertex with `r` (for 000 Fig. 7b), if defined.
+    fn adjacent(_r: u8) -> Option<RelationSet> {
+        None
+    }
+
     /// The EDC regions a measurement must test when `open` relations are still possible.
     fn edc_candidates(open: RelationSet) -> RelationSet {
         RelationSet::from_relations((1..=crate::edc::REGIONS).filter(|&r| {

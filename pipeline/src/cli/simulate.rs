@@ -2,7 +2,7 @@
 
 use super::output::write_atomic;
 use super::CalculusName;
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use qrm::calculus::Calculus;
@@ -20,6 +20,9 @@ use rand::SeedableRng;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::time::Instant;
+
+/// Largest simulated map: 300 landmarks are 4.5 M triples (about 60 MB) and take minutes.
+const MAX_SIMULATED_LANDMARKS: usize = 300;
 
 #[derive(Subcommand, Debug)]
 pub enum SimulateCommand {
@@ -53,6 +56,9 @@ pub struct SensorArgs {
 
 impl SensorArgs {
     fn sensor(&self, nearest: Option<usize>) -> Result<Sensor> {
+        if nearest.is_some_and(|n| n < 3) {
+            bail!("--nearest must be at least 3 (a triple)");
+        }
         if !(0.0..MAX_BEARING_UNCERTAINTY.to_degrees()).contains(&self.bearing_noise) {
             bail!(
                 "--bearing-noise {} must lie in [0, {}) degrees",
@@ -171,6 +177,8 @@ fn montecarlo(args: MonteCarloArgs) -> Result<()> {
     write_atomic(&args.out.join("montecarlo.csv"), result.to_csv().as_bytes())?;
     let summary = summary(&result, elapsed);
     write_atomic(&args.out.join("summary.txt"), summary.as_bytes())?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create directory {}", args.out.display()))?;
     let panels = montecarlo_panels(&result);
     for name in ["montecarlo.png", "montecarlo.svg"] {
         write_panels(&args.out.join(name), "image number", &panels)?;
@@ -318,6 +326,12 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
     if args.landmarks < 3 || args.stations == 0 {
         bail!("need at least 3 landmarks and 1 imaging point");
     }
+    if args.landmarks > MAX_SIMULATED_LANDMARKS {
+        bail!(
+            "--landmarks {} is more than this simulation handles ({MAX_SIMULATED_LANDMARKS}): the map grows as n³",
+            args.landmarks
+        );
+    }
     let scenario = Scenario::random(args.seed, args.landmarks, args.stations, 100.0);
     let sensor = args.sensor.sensor(args.nearest)?;
     let start = Instant::now();
@@ -344,13 +358,10 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
             s.metrics.unsound_relations
         );
     }
-    write_atomic(&args.out.join("steps.csv"), csv.as_bytes())?;
-    write_atomic(&args.out.join("map.json"), map.to_json().as_bytes())?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create directory {}", args.out.display()))?;
+    // The picture is the only output that can fail on the data, so it goes first.
     if let Some(rng) = estimate(&map) {
-        write_atomic(
-            &args.out.join("rng.json"),
-            super::rng_json(&map, &rng).as_bytes(),
-        )?;
         let landmarks: Vec<(f64, f64)> = map
             .landmarks()
             .iter()
@@ -383,6 +394,10 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
                 stations: &stations,
             },
         )?;
+        write_atomic(
+            &args.out.join("rng.json"),
+            super::rng_json(&map, &rng).as_bytes(),
+        )?;
         println!(
             "RNG: {} edges kept ({} certain), {} pruned; true RNG has {} edges",
             rng.edges.len(),
@@ -391,6 +406,8 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
             true_edges.len()
         );
     }
+    write_atomic(&args.out.join("steps.csv"), csv.as_bytes())?;
+    write_atomic(&args.out.join("map.json"), map.to_json().as_bytes())?;
     let last = steps.last().expect("at least one station");
     println!(
         "{} map of {} landmarks after {} images in {:.2} s: {:.1}% incorrect states removed, {:.1}% triples fully constrained, {} unsound relations, {} contradictions",

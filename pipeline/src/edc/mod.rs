@@ -34,6 +34,10 @@ impl Calculus for Edc {
         regions
     }
 
+    fn adjacent(r: u8) -> Option<RelationSet> {
+        Some(ADJACENT[r as usize - 1])
+    }
+
     fn lune() -> Option<RelationSet> {
         Some(RelationSet::from_relations(LUNE))
     }

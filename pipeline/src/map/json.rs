@@ -49,6 +49,8 @@ pub enum MapFormatError {
     },
     #[error("landmark {0} is listed twice")]
     DuplicateLandmark(LandmarkId),
+    #[error("{0} landmarks: this reader accepts at most {MAX_LANDMARKS} (memory grows as n³)")]
+    TooManyLandmarks(usize),
     #[error("triple {ids:?}: {reason}")]
     Triple {
         ids: [LandmarkId; 3],
@@ -64,6 +66,9 @@ pub enum MapFormatError {
         closed: RelationSet,
     },
 }
+
+/// Largest map [`Hypergraph::from_json`] loads: 1 000 landmarks are 166 M triples, 2 GB.
+pub const MAX_LANDMARKS: usize = 1000;
 
 fn to_numbers(s: RelationSet) -> Vec<i64> {
     s.iter().map(i64::from).collect()
@@ -111,6 +116,9 @@ impl<C: Calculus> Hypergraph<C> {
                 expected: C::NAME,
                 found: file.calculus,
             });
+        }
+        if file.landmarks.len() > MAX_LANDMARKS {
+            return Err(MapFormatError::TooManyLandmarks(file.landmarks.len()));
         }
         let mut map = Hypergraph::<C>::new();
         for &id in &file.landmarks {

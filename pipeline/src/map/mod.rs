@@ -17,7 +17,7 @@ mod transaction;
 mod update;
 
 pub use hypergraph::{Hypergraph, Triples};
-pub use json::MapFormatError;
+pub use json::{MapFormatError, MAX_LANDMARKS};
 pub use update::{Contradiction, ContradictionStage, LandmarkId, Observation, UpdateReport};
 
 use crate::calculus::Calculus;

@@ -45,9 +45,12 @@ impl Interval {
         )
     }
 
-    /// Entirely above (`sign > 0`) or below zero, beyond rounding.
+    /// Entirely above (`sign > 0`) or below zero, beyond rounding. The arithmetic is not
+    /// outward-rounded; every quantity is O(1) (ranges on the unit simplex, unit directions), so
+    /// an absolute slack of 10⁻¹³ plus 10⁻¹² relative exceeds what a boundary function's dozen
+    /// operations can lose.
     fn excludes_sign(self, sign: i8) -> bool {
-        let slack = 1e-12 * (self.lo.abs() + self.hi.abs());
+        let slack = 1e-13 + 1e-12 * (self.lo.abs() + self.hi.abs());
         if sign > 0 {
             self.hi < -slack
         } else {

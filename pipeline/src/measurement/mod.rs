@@ -4,7 +4,7 @@
 //! Beyond the paper, for real sensors: the range order may be partial ([`RangeOrder`]), and each
 //! bearing may carry an uncertainty interval. Every result is sound: an arrangement whose
 //! bearings lie within their intervals and whose ranges respect the order is never excluded
-//! (up to the feasibility engine's documented margin).
+//! (`docs/MEASUREMENT.md` states the numerical limits).
 
 mod interval;
 mod range_order;
@@ -21,9 +21,14 @@ use rayon::prelude::*;
 use std::f64::consts::FRAC_PI_4;
 use thiserror::Error;
 
-/// Largest accepted half-width of a bearing interval. Sectors must stay well inside a half
-/// plane for the formulation's `|t| ≤ s·tan δ`; 45° is far beyond any camera's error.
+/// Largest accepted half-width of a bearing interval: far beyond any camera's error, and wide
+/// intervals make the interval enclosures (and the search formulation's `|t| ≤ s·tan δ`)
+/// useless long before the sectors reach a half plane.
 pub const MAX_BEARING_UNCERTAINTY: f64 = FRAC_PI_4;
+
+/// Largest accepted |bearing| in radians: angles are taken modulo 2π, but a huge angle has lost
+/// its fractional turn to rounding and means nothing.
+pub const MAX_BEARING_MAGNITUDE: f64 = 1e6;
 
 /// The direction to a landmark in the camera frame (radians, counter-clockwise; any zero),
 /// known to within `± uncertainty`.
@@ -55,6 +60,8 @@ pub struct Panorama {
 pub enum MeasurementError {
     #[error("bearing of landmark {index} is not a finite angle ({angle})")]
     BearingNotFinite { index: usize, angle: f64 },
+    #[error("bearing of landmark {index} is {angle} rad; give angles within ±{max} rad")]
+    BearingOutOfRange { index: usize, angle: f64, max: f64 },
     #[error(
         "bearing uncertainty of landmark {index} is {value} rad; it must lie in [0, {max}) rad"
     )]
@@ -70,6 +77,13 @@ impl Panorama {
                 return Err(MeasurementError::BearingNotFinite {
                     index,
                     angle: b.angle,
+                });
+            }
+            if b.angle.abs() > MAX_BEARING_MAGNITUDE {
+                return Err(MeasurementError::BearingOutOfRange {
+                    index,
+                    angle: b.angle,
+                    max: MAX_BEARING_MAGNITUDE,
                 });
             }
             if !(0.0..MAX_BEARING_UNCERTAINTY).contains(&b.uncertainty) {

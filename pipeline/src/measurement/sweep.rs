@@ -16,7 +16,8 @@
 //! critical value is met just beside it too (regions are open). So one `r` inside every gap and
 //! one `s` inside every ray interval visit every region the observation allows. Each sample is
 //! classified with a tolerance: a boundary value within rounding of zero counts as both signs,
-//! so sampling a numerically tiny interval can add a neighbour but never lose a region.
+//! so sampling a numerically tiny interval can add a neighbour but never lose a region; and no
+//! gap is skipped, however narrow.
 
 use crate::calculus::RelationSet;
 use crate::edc::region_of_signs;
@@ -43,9 +44,6 @@ const VERTICES: [(f64, f64); 11] = [
 /// Relative size below which a boundary value counts as zero when classifying a sample.
 const ZERO_TOLERANCE: f64 = 1e-9;
 
-/// Relative width below which a gap between critical values is not sampled.
-const GAP_TOLERANCE: f64 = 1e-9;
-
 /// The EDC regions of `AB:C` reachable when A, B, C lie on the rays `u` (unit vectors, camera
 /// at the origin) with ranges ordered by `nearer` (`(p, q)`: landmark `p` of `[A, B, C]` is
 /// nearer than `q`; transitively closed), among `wanted` (the sweep stops once all are found).
@@ -70,7 +68,7 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
         }
     }
     let mut critical = critical_ranges(u, &functions);
-    for r in gap_samples(&mut critical, r_lo, r_hi, 0.0) {
+    for r in gap_samples(&mut critical, r_lo, r_hi) {
         found = found.union(regions_along_ray(&functions, nearer, r, &mut roots));
         if wanted.is_subset(found) {
             break;
@@ -113,7 +111,7 @@ fn regions_along_ray(
     for f in &functions.0 {
         push_roots(roots, f.ss, f.rs * r + f.s, (f.rr * r + f.r) * r + f.c);
     }
-    for s in gap_samples(roots, s_lo, s_hi, r.min(1.0)) {
+    for s in gap_samples(roots, s_lo, s_hi) {
         found = found.union(functions.regions_at(r, s));
     }
     found
@@ -151,29 +149,21 @@ fn critical_ranges(u: [Point; 3], functions: &BoundaryPolynomials) -> Vec<f64> {
     critical
 }
 
-/// Midpoints of the gaps between the sorted `points` inside `(lo, hi)`, plus a point inside
-/// each unbounded or end gap. Cuts closer than [`GAP_TOLERANCE`] × max(`scale`, |cut|) are one
-/// cut: such gaps are rounding artefacts of coinciding events (sampling one would land on a
-/// boundary and blur the result), or slivers thinner than the search engine's margin.
-fn gap_samples(points: &mut Vec<f64>, lo: f64, hi: f64, scale: f64) -> Vec<f64> {
+/// A point inside every gap between the sorted `points` within `(lo, hi)`, including the end
+/// gaps. Every gap is sampled, however narrow: a narrow gap may be a genuine sliver of a region
+/// (e.g. the cusp between circle B and the perpendicular at A, both through A, is ε² wide on a
+/// ray ε from A's bearing), and a sample that falls on a boundary in rounding is classified
+/// into both neighbours by [`BoundaryPolynomials::regions_at`].
+fn gap_samples(points: &mut Vec<f64>, lo: f64, hi: f64) -> Vec<f64> {
     points.retain(|&x| x > lo && x < hi);
     points.sort_by(f64::total_cmp);
-    let mut cuts: Vec<f64> = Vec::with_capacity(points.len() + 2);
-    cuts.push(lo);
+    points.dedup();
+    let mut samples = Vec::with_capacity(points.len() + 1);
+    let mut last = lo;
     for &x in points.iter() {
-        let last = *cuts.last().expect("lo is a cut");
-        if x - last > GAP_TOLERANCE * scale.max(x.abs()) {
-            cuts.push(x);
-        }
+        samples.push(inside(last, x));
+        last = x;
     }
-    if hi.is_finite() && hi - cuts[cuts.len() - 1] <= GAP_TOLERANCE * scale.max(hi.abs()) {
-        cuts.pop();
-        if cuts.is_empty() {
-            return Vec::new();
-        }
-    }
-    let mut samples: Vec<f64> = cuts.windows(2).map(|w| inside(w[0], w[1])).collect();
-    let last = *cuts.last().expect("lo is a cut");
     samples.push(if hi.is_finite() {
         inside(last, hi)
     } else {
@@ -202,8 +192,8 @@ fn push_roots(out: &mut Vec<f64>, a: f64, b: f64, c: f64) {
         return;
     }
     let (a, b, c) = (a / scale, b / scale, c / scale);
-    if a.abs() < 1e-14 {
-        if b.abs() > 1e-14 && (c / b).is_finite() {
+    if a == 0.0 {
+        if b != 0.0 {
             out.push(-c / b);
         }
         return;
@@ -217,7 +207,8 @@ fn push_roots(out: &mut Vec<f64>, a: f64, b: f64, c: f64) {
             return;
         }
     }
-    // Numerically stable pair of roots.
+    // Numerically stable pair of roots; with a tiny `a` one is huge and the other is the root
+    // of the nearly linear polynomial.
     let q = -0.5 * (b + b.signum() * disc.sqrt());
     let roots = if q != 0.0 { [q / a, c / q] } else { [0.0, 0.0] };
     out.extend(roots.into_iter().filter(|x| x.is_finite()));
@@ -408,7 +399,10 @@ mod tests {
         push_roots(&mut out, 1.0, -3.0, 2.0);
         out.sort_by(f64::total_cmp);
         assert_eq!(out.len(), 2);
-        assert!((out[0] - 1.0).abs() < 1e-12 && (out[1] - 2.0).abs() < 1e-12, "{out:?}");
+        assert!(
+            (out[0] - 1.0).abs() < 1e-12 && (out[1] - 2.0).abs() < 1e-12,
+            "{out:?}"
+        );
         out.clear();
         push_roots(&mut out, 0.0, 2.0, -1.0);
         assert_eq!(out, vec![0.5]);

@@ -1,5 +1,7 @@
-//! The feasibility formulation of one measured triple (000 §IV, Fig. 4, Table III), generalised
-//! to uncertain bearings and partial range orders.
+//! One measured triple: the dispatch to the sweep (exact bearings) or the interval method
+//! (uncertain bearings), and the paper's feasibility formulation (000 §IV, Fig. 4, Table III),
+//! generalised to uncertain bearings and partial range orders, decided by branch and bound
+//! ([`by_search`], the reference the tests compare the fast methods with).
 //!
 //! The camera sits at the origin; landmark `X` lies at `s_X·u_X + t_X·v_X`, where `u_X` is the
 //! unit vector of its measured bearing, `v_X ⊥ u_X`, `s_X > 0` its range along `u_X` and
@@ -85,32 +87,26 @@ pub fn by_sweep(
     })
 }
 
-/// Any bearings: regions reached at the nominal bearings (by sweep) are possible; one
-/// branch-and-bound search over the bearing intervals decides the regions of all three
-/// relations that are left.
+/// Any bearings, the paper's way: one branch-and-bound search decides the candidate regions of
+/// all three relations (undecided ones are kept). About 10 ms per triple, so the pipeline uses
+/// the sweep and the interval method; this is their independent reference in the tests.
 pub fn by_search(
     bearings: [Bearing; 3],
     nearer: &[(usize, usize)],
     candidates: TripleRelations,
     engine: &BranchAndBound,
 ) -> TripleRelations {
-    let nominal = by_sweep(
-        bearings.map(|b| Bearing::exact(b.angle)),
-        nearer,
-        candidates,
-    );
-    let undecided: TripleRelations = std::array::from_fn(|k| candidates[k].difference(nominal[k]));
     let formulation = Formulation::new(&bearings, nearer);
     let mut index = Vec::new();
     let mut alternatives = Vec::new();
-    for (k, set) in undecided.iter().enumerate() {
+    for (k, set) in candidates.iter().enumerate() {
         let [p, q, w] = formulation.rotated(k);
         for region in set.iter() {
             index.push((k, region));
             alternatives.push(region_constraints(p, q, w, region));
         }
     }
-    let mut result = nominal;
+    let mut result = [RelationSet::EMPTY; 3];
     if alternatives.is_empty() {
         return result;
     }

@@ -130,7 +130,8 @@ pub struct Series {
     /// Final RNG precision and recall over the maps.
     pub rng_precision: Statistic,
     pub rng_recall: Statistic,
-    /// Rejected panoramas and relations that lost their true state, over all maps and images.
+    /// Rejected panoramas over all maps and images; relations that lost their true state,
+    /// summed over the maps of each map's worst image.
     pub contradictions: usize,
     pub unsound_relations: usize,
 }

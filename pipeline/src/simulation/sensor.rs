@@ -17,7 +17,8 @@ pub struct Sensor {
     /// … and the measurement is told they are within `±bearing_uncertainty`. Equal values make
     /// a correct error model; a smaller uncertainty than noise tests contradiction handling.
     pub bearing_uncertainty: f64,
-    /// Probability that each adjacent pair of the true range order is swapped.
+    /// Range-order errors: walking the true order nearest first, each position is swapped with
+    /// the one before it with this probability (so a landmark can drift several places).
     pub order_swap_probability: f64,
 }
 
