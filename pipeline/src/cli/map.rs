@@ -74,14 +74,8 @@ pub fn run_command(command: MapCommand) -> Result<()> {
 fn info<C: Calculus>(map: &Hypergraph<C>, rng_out: Option<&Path>) -> Result<()> {
     let states = C::universe().len();
     let triples = map.triple_count();
-    let open: usize = map
-        .triples()
-        .map(|t| t.3.iter().map(|s| s.len()).sum::<usize>())
-        .sum();
-    let full = map
-        .triples()
-        .filter(|t| t.3.iter().all(|s| s.len() == 1))
-        .count();
+    let open = map.open_states();
+    let full = map.fully_constrained_triples();
     println!(
         "{} map: {} landmarks, {} triples",
         C::NAME,

@@ -444,11 +444,6 @@ fn basic<C: Calculus>(seed: u64) -> Result<()> {
         .collect();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let mut map = Hypergraph::<C>::new();
-    let open = |m: &Hypergraph<C>| {
-        m.triples()
-            .map(|t| t.3.iter().map(|s| s.len()).sum::<usize>())
-            .sum::<usize>()
-    };
     println!(
         "{} map of 4 landmarks {:?}",
         C::NAME,
@@ -465,15 +460,12 @@ fn basic<C: Calculus>(seed: u64) -> Result<()> {
                 let (ids, panorama) = sensor.observe(&scenario.landmarks, station, &mut rng);
                 let mut trial = map.clone();
                 let _ = trial.fuse(&observations(&trial, &ids, &panorama));
-                (open(&trial), station, trial)
+                (trial.open_states(), station, trial)
             })
             .min_by_key(|(open, _, _)| *open)
             .expect("candidates");
         map = best.2;
-        let full = map
-            .triples()
-            .filter(|t| t.3.iter().all(|s| s.len() == 1))
-            .count();
+        let full = map.fully_constrained_triples();
         println!(
             "image {image} at ({:.1}, {:.1}): {} open states in {} triples, {} fully constrained",
             best.1.x,

@@ -57,6 +57,20 @@ impl<C: Calculus> Hypergraph<C> {
         self.edges.len()
     }
 
+    /// Open states summed over every relation of every edge (003 §1.5.1's first metric).
+    pub fn open_states(&self) -> usize {
+        self.triples()
+            .map(|(_, _, _, r)| r.iter().map(|s| s.len()).sum::<usize>())
+            .sum()
+    }
+
+    /// Edges whose three relations are each a single state.
+    pub fn fully_constrained_triples(&self) -> usize {
+        self.triples()
+            .filter(|(_, _, _, r)| r.iter().all(|s| s.len() == 1))
+            .count()
+    }
+
     /// Heap bytes held by the map (edges, landmark list and id index).
     pub fn heap_bytes(&self) -> usize {
         self.edges.capacity() * std::mem::size_of::<[u32; 3]>()

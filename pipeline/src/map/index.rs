@@ -87,16 +87,22 @@ pub(crate) struct Location {
     pub inverted: bool,
 }
 
-/// Locates `ab:c` for distinct internal indices.
-pub(crate) fn locate(a: usize, b: usize, c: usize) -> Location {
-    let [i, j, k] = sort3(a, b, c);
-    let (slot, inverted) = if c == k {
+/// The stored slot of `ab:c` in the edge `i < j < k` and whether it is read through INVERSE:
+/// slot 0 holds `ij:k`, 1 `jk:i`, 2 `ki:j`.
+pub(crate) const fn slot_of(a: usize, c: usize, [i, j, k]: [usize; 3]) -> (usize, bool) {
+    if c == k {
         (0, a != i)
     } else if c == i {
         (1, a != j)
     } else {
         (2, a != k)
-    };
+    }
+}
+
+/// Locates `ab:c` for distinct internal indices.
+pub(crate) fn locate(a: usize, b: usize, c: usize) -> Location {
+    let [i, j, k] = sort3(a, b, c);
+    let (slot, inverted) = slot_of(a, c, [i, j, k]);
     Location {
         rank: rank(i, j, k),
         slot,

@@ -5,6 +5,7 @@
 //! read once per 4-set instead of once per composition, and a narrowing is used by the
 //! remaining compositions of the 4-set immediately.
 
+use super::index::slot_of;
 use super::kernel::Kernel;
 
 /// A narrowed edge: its rank and the relations to intersect in.
@@ -28,13 +29,7 @@ const fn ordered(a: usize, b: usize, c: usize) -> usize {
         2 => (0, 1, 3),
         _ => (0, 1, 2),
     };
-    let (slot, inverted) = if c == k {
-        (0, a != i)
-    } else if c == i {
-        (1, a != j)
-    } else {
-        (2, a != k)
-    };
+    let (slot, inverted) = slot_of(a, c, [i, j, k]);
     6 * missing + slot + if inverted { 3 } else { 0 }
 }
 
