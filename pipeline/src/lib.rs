@@ -3,6 +3,7 @@
 //! Stages live in one module each; see `docs/ARCHITECTURE.md`.
 
 pub mod calculus;
+pub mod calib;
 pub mod edc;
 pub mod fdc;
 pub mod feasibility;
