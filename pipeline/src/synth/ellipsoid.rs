@@ -24,7 +24,7 @@ impl Ellipsoid {
     }
 
     /// A world vector in the unit-sphere frame (no translation).
-    fn to_unit(&self, v: [f64; 3]) -> [f64; 3] {
+    fn unit_frame(&self, v: [f64; 3]) -> [f64; 3] {
         [
             (self.cos * v[0] + self.sin * v[1]) * self.inverse_radii[0],
             (-self.sin * v[0] + self.cos * v[1]) * self.inverse_radii[1],
@@ -34,12 +34,12 @@ impl Ellipsoid {
 
     /// Smallest ray parameter `t > min_t` at which `origin + t·direction` meets the surface.
     pub fn hit(&self, origin: [f64; 3], direction: [f64; 3], min_t: f64) -> Option<f64> {
-        let o = self.to_unit([
+        let o = self.unit_frame([
             origin[0] - self.center[0],
             origin[1] - self.center[1],
             origin[2] - self.center[2],
         ]);
-        let d = self.to_unit(direction);
+        let d = self.unit_frame(direction);
         let a = dot(d, d);
         let b = dot(o, d);
         let c = dot(o, o) - 1.0;
@@ -59,7 +59,7 @@ impl Ellipsoid {
     /// Outward unit normal at surface point `p`: the gradient of the implicit function, taken
     /// back from the unit-sphere frame.
     pub fn normal(&self, p: [f64; 3]) -> [f64; 3] {
-        let u = self.to_unit([
+        let u = self.unit_frame([
             p[0] - self.center[0],
             p[1] - self.center[1],
             p[2] - self.center[2],

@@ -35,8 +35,8 @@ impl Render {
                 for yy in y * f..(y + 1) * f {
                     for xx in x * f..(x + 1) * f {
                         let i = 3 * (yy * self.width as usize + xx);
-                        for k in 0..3 {
-                            sum[k] += u32::from(self.rgb[i + k]);
+                        for (total, &v) in sum.iter_mut().zip(&self.rgb[i..i + 3]) {
+                            *total += u32::from(v);
                         }
                     }
                 }

@@ -75,7 +75,7 @@ pub fn fbm2(seed: u64, x: f64, y: f64, octaves: u32, footprint: f64) -> f64 {
             sum += amplitude * 0.5;
         } else {
             let n = value2(
-                seed.wrapping_add(u64::from(octave) * 0x632B_E59B_D9B4_E019),
+                seed.wrapping_add(u64::from(octave).wrapping_mul(0x632B_E59B_D9B4_E019)),
                 x * frequency + f64::from(octave) * 17.31,
                 y * frequency - f64::from(octave) * 9.77,
             );
@@ -95,7 +95,7 @@ pub fn fbm3(seed: u64, p: [f64; 3], octaves: u32) -> f64 {
         let shift = f64::from(octave) * 5.37;
         sum += amplitude
             * value3(
-                seed.wrapping_add(u64::from(octave) * 0x632B_E59B_D9B4_E019),
+                seed.wrapping_add(u64::from(octave).wrapping_mul(0x632B_E59B_D9B4_E019)),
                 [
                     p[0] * frequency + shift,
                     p[1] * frequency - shift,
