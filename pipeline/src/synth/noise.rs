@@ -19,6 +19,44 @@ fn lattice(seed: u64, x: i64, y: i64, z: i64) -> f64 {
     (hash(seed, x, y, z) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
+/// Uniform value in `[0, 1)` for lattice cell `cell` and draw number `k`: the random features
+/// (positions, sizes, tilts) that cellular textures attach to each cell.
+pub fn cell_value(seed: u64, cell: [i64; 3], k: u64) -> f64 {
+    lattice(
+        seed ^ k.wrapping_mul(0xD6E8_FEB8_6659_FD93),
+        cell[0],
+        cell[1],
+        cell[2],
+    )
+}
+
+/// The cell (of the unit lattice) whose jittered feature point is nearest to `p`: a Voronoi
+/// partition, whose cells become the flat facets of rock surfaces.
+pub fn nearest_cell3(seed: u64, p: [f64; 3]) -> [i64; 3] {
+    let base = [
+        p[0].floor() as i64,
+        p[1].floor() as i64,
+        p[2].floor() as i64,
+    ];
+    let mut best = (f64::INFINITY, base);
+    for dz in -1..=1 {
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let cell = [base[0] + dx, base[1] + dy, base[2] + dz];
+                let mut d2 = 0.0;
+                for k in 0..3 {
+                    let feature = cell[k] as f64 + cell_value(seed, cell, k as u64);
+                    d2 += (feature - p[k]) * (feature - p[k]);
+                }
+                if d2 < best.0 {
+                    best = (d2, cell);
+                }
+            }
+        }
+    }
+    best.1
+}
+
 /// Cubic fade so that the interpolated noise has a continuous gradient.
 fn fade(t: f64) -> f64 {
     t * t * (3.0 - 2.0 * t)
@@ -129,6 +167,15 @@ mod tests {
             differs |= (value2(4, x, y) - v).abs() > 1e-3;
         }
         assert!(differs, "the seed changes the noise");
+    }
+
+    #[test]
+    fn nearest_cell_owns_its_feature_point() {
+        for i in 0..200 {
+            let cell = [i - 100, 3 * i % 17, -(i % 5)];
+            let feature = [0, 1, 2].map(|k| cell[k] as f64 + cell_value(8, cell, k as u64));
+            assert_eq!(nearest_cell3(8, feature), cell);
+        }
     }
 
     #[test]

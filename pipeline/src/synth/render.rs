@@ -140,9 +140,10 @@ pub fn render(world: &World, calib: &Calibration, pose: Pose, eye: Eye) -> Rende
                     // A pixel covers about t·Δazimuth across and t²/(focal·mast) along the range.
                     let footprint = (t_best * column_width)
                         .max(t_best * t_best / (calib.elevation.focal_px * mast));
-                    let albedo = shade::ground(world.seed, p[0], p[1], footprint);
-                    let lit = shadows.ground_lit(&scene, p[0], p[1]);
-                    let c = shade::light(albedo, [0.0, 0.0, 1.0], scene.sun, lit);
+                    let (albedo, n, open) =
+                        shade::ground(world.seed, p[0], p[1], footprint, scene.sun);
+                    let lit = open && shadows.ground_lit(&scene, p[0], p[1]);
+                    let c = shade::light(albedo, n, scene.sun, lit);
                     shade::haze(c, t_best * slant, world.haze)
                 } else if rise < 0.0 {
                     shade::HORIZON
