@@ -152,7 +152,7 @@ pub fn rock(body: &Body, p: [f64; 3], n: [f64; 3]) -> (Rgb, [f64; 3]) {
     let mottle = fbm3(seed, q.map(|v| v * 5.0), 4);
     let layers = fbm3(seed ^ 5, [q[0] * 1.5, q[1] * 1.5, q[2] * 12.0], 2);
     let tone = 0.65 + 0.7 * mottle + 0.35 * (layers - 0.5);
-    let facet = nearest_cell3(seed ^ 7, q.map(|v| v * 2.5));
+    let facet = nearest_cell3(seed ^ 7, q.map(|v| v * 1.8));
     let tilt = [0, 1, 2].map(|i| cell_value(seed ^ 7, facet, 10 + i) - 0.5);
     let facet_tone = 0.85 + 0.3 * cell_value(seed ^ 7, facet, 13);
     let dust = ((n[2] - 0.6) * 2.0).clamp(0.0, 1.0) * 0.45;
@@ -163,9 +163,9 @@ pub fn rock(body: &Body, p: [f64; 3], n: [f64; 3]) -> (Rgb, [f64; 3]) {
     );
     let grit = [0.0, 1.0, 2.0].map(|o| fbm3(seed ^ 9, q.map(|v| v * 14.0 + o * 3.1), 2) - 0.5);
     let bumped = normalize([
-        n[0] + 0.9 * tilt[0] + 0.35 * grit[0],
-        n[1] + 0.9 * tilt[1] + 0.35 * grit[1],
-        n[2] + 0.9 * tilt[2] + 0.35 * grit[2],
+        n[0] + 1.3 * tilt[0] + 0.35 * grit[0],
+        n[1] + 1.3 * tilt[1] + 0.35 * grit[1],
+        n[2] + 1.3 * tilt[2] + 0.35 * grit[2],
     ]);
     (albedo, bumped)
 }

@@ -116,9 +116,9 @@ impl World {
 
 /// A rock of about `size` radius: a flattened main lump resting on the ground and up to three
 /// smaller lumps fused to it, sunk by 15–50 % of the main lump's height, in a Mars palette
-/// from dark basalt grey to ochre.
+/// from dark basalt grey to pale ochre.
 fn random_rock(id: u32, position: Point, size: f64, rng: &mut ChaCha8Rng) -> Rock {
-    let main_height = size * rng.random_range(0.45..0.85);
+    let main_height = size * rng.random_range(0.3..0.8);
     let mut lumps = vec![Lump {
         center: [0.0, 0.0, main_height],
         radii: [
@@ -146,12 +146,12 @@ fn random_rock(id: u32, position: Point, size: f64, rng: &mut ChaCha8Rng) -> Roc
             yaw: rng.random_range(0.0..PI),
         });
     }
-    let brightness = rng.random_range(0.35f32..1.0);
+    let brightness = rng.random_range(0.5f32..1.3);
     let redness = rng.random_range(0.0f32..1.0);
     let albedo = [
-        brightness * (0.16 + 0.14 * redness),
-        brightness * (0.12 + 0.05 * redness),
-        brightness * (0.10 + 0.01 * redness),
+        brightness * (0.20 + 0.16 * redness),
+        brightness * (0.16 + 0.05 * redness),
+        brightness * (0.13 + 0.01 * redness),
     ];
     Rock {
         id,
