@@ -163,6 +163,12 @@ fn rendering_is_deterministic() {
     let a = render(&world, &calib, POSE, Eye::Left);
     let b = render(&World::generate(3, &placements()), &calib, POSE, Eye::Left);
     assert!(a == b, "same seed, same bytes");
+    let serial = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| render(&world, &calib, POSE, Eye::Left));
+    assert!(a == serial, "the thread count does not matter");
     let c = render(&World::generate(4, &placements()), &calib, POSE, Eye::Left);
     assert!(a.rgb != c.rgb, "another seed, another image");
 }
