@@ -15,3 +15,4 @@ pub mod metrics;
 pub mod neighborhood;
 pub mod plot;
 pub mod simulation;
+pub mod synth;

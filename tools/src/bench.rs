@@ -2,7 +2,8 @@
 //! - median time of one 2-unknown feasibility decision (all 3 × 20 × 20 EDC unary problems),
 //! - median time of one 4-unknown decision (a deterministic sample of composition triples),
 //! - wall time to regenerate each table;
-//! - with `--closure`: path-consistency closure of complete random maps (000 §VI-B).
+//! - with `--closure`: path-consistency closure of complete random maps (000 §VI-B);
+//! - with `--render`: synthetic panoramas (issue 4), one stereo pair and a 50-station set.
 
 use clap::Parser;
 use qrm::calculus::{Calculus, RelationSet};
@@ -42,6 +43,70 @@ struct Args {
     /// Fuse each closure network this many times into a fresh map; prints min and median.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     repeat: u32,
+    /// Time the synthetic renderer instead (30 rocks, `calib/default.toml`).
+    #[arg(long)]
+    render: bool,
+    /// With `--render`: also save the left image of the first pair, shrunk 4×, as this PNG.
+    #[arg(long, value_name = "PNG")]
+    preview: Option<std::path::PathBuf>,
+}
+
+/// Renders stereo pairs of 30 random rocks in a 20 m square with the default calibration:
+/// one pair from the centre (minimum and median of five), then 50 stations around a loop;
+/// prints wall times and optionally saves a preview of the first left image.
+fn bench_render(preview: Option<&std::path::Path>) {
+    use qrm::synth::{render, Eye, Pose, World};
+    let calib = qrm::calib::Calibration::parse(
+        include_str!("../../calib/default.toml"),
+        "calib/default.toml",
+    )
+    .expect("the default calibration parses");
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+    let placements: Vec<(Point, f64)> = (0..30)
+        .map(|_| {
+            (
+                Point::new(rng.random_range(-10.0..10.0), rng.random_range(-10.0..10.0)),
+                rng.random_range(0.1..0.45),
+            )
+        })
+        .collect();
+    let world = World::generate(4, &placements);
+    let centre = Pose {
+        position: Point::new(0.3, -0.4),
+        heading: 0.0,
+    };
+    let mut times = Vec::new();
+    for i in 0..5 {
+        let start = Instant::now();
+        let left = render(&world, &calib, centre, Eye::Left);
+        let right = render(&world, &calib, centre, Eye::Right);
+        times.push(start.elapsed().as_secs_f64());
+        if i == 0 {
+            if let Some(path) = preview {
+                left.downscale(4).save_png(path).expect("preview written");
+            }
+            std::hint::black_box(right);
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    println!(
+        "render: one {}x{} stereo pair, 30 rocks: min {:.3} s, median {:.3} s",
+        calib.image.width, calib.image.height, times[0], times[2]
+    );
+    let start = Instant::now();
+    for k in 0..50 {
+        let angle = std::f64::consts::TAU * f64::from(k) / 50.0;
+        let pose = Pose {
+            position: Point::new(6.0 * angle.cos(), 6.0 * angle.sin()),
+            heading: angle + std::f64::consts::FRAC_PI_2,
+        };
+        std::hint::black_box(render(&world, &calib, pose, Eye::Left));
+        std::hint::black_box(render(&world, &calib, pose, Eye::Right));
+    }
+    println!(
+        "render: 50 stations (50 stereo pairs), 30 rocks: {:.2} s",
+        start.elapsed().as_secs_f64()
+    );
 }
 
 /// Measures one random panorama of `n` landmarks (uniform in a square around the camera,
@@ -199,6 +264,10 @@ fn time_decisions(problems: &[(Vec<f64>, Vec<f64>, Vec<Quadratic>)]) -> (f64, f6
 
 fn main() {
     let args = Args::parse();
+    if args.render {
+        bench_render(args.preview.as_deref());
+        return;
+    }
     if !args.measure.is_empty() {
         for &n in &args.measure {
             bench_measure(n, args.uncertainty);
