@@ -4,6 +4,7 @@
 
 pub mod calculus;
 pub mod calib;
+pub mod dataset;
 pub mod edc;
 pub mod fdc;
 pub mod feasibility;

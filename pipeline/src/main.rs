@@ -75,6 +75,9 @@ enum Command {
     /// Inspect or merge saved maps (JSON, docs/MAP_FORMAT.md).
     #[command(subcommand)]
     Map(cli::map::MapCommand),
+    /// Render a synthetic dataset: stereo panoramas of a rock field with ground truth
+    /// (datasets/README.md), e.g. `synth --preset marsyard --seed 1 --out data/marsyard`.
+    Synth(cli::synth::SynthArgs),
 }
 
 fn parse_point(text: &str) -> Result<Point> {
@@ -204,6 +207,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Measure(args) => cli::measure::run(args)?,
         Command::Simulate(command) => cli::simulate::run_command(command)?,
         Command::Map(command) => cli::map::run_command(command)?,
+        Command::Synth(args) => cli::synth::run(args)?,
     }
     Ok(())
 }

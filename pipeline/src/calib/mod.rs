@@ -221,16 +221,18 @@ impl Calibration {
 
     /// Horizontal range from the stereo disparity (azimuth difference, radians) of a point,
     /// for a rotating head whose cameras sit ±baseline/2 across the viewing direction: the
-    /// left camera sees a point at range `d` rotated by `atan(b / 2d)` one way, the right one
-    /// the other way, so disparity = 2·atan(b / 2d).
+    /// column of the left camera whose ray passes a point at range `d` looks `asin(b / 2d)` to
+    /// one side of the point's bearing, the right camera's to the other, so
+    /// disparity = 2·asin(b / 2d).
     pub fn stereo_range(&self, disparity: f64) -> Option<f64> {
-        (disparity > 0.0 && self.stereo.baseline_m > 0.0)
-            .then(|| self.stereo.baseline_m / (2.0 * (disparity / 2.0).tan()))
+        (disparity > 0.0 && disparity < std::f64::consts::PI && self.stereo.baseline_m > 0.0)
+            .then(|| self.stereo.baseline_m / (2.0 * (disparity / 2.0).sin()))
     }
 
-    /// The stereo disparity (radians) of a point at horizontal range `range`.
+    /// The stereo disparity (radians) of a point at horizontal range `range` (at least half the
+    /// baseline: nearer points are between the cameras).
     pub fn stereo_disparity(&self, range: f64) -> f64 {
-        2.0 * (self.stereo.baseline_m / (2.0 * range)).atan()
+        2.0 * (self.stereo.baseline_m / (2.0 * range)).min(1.0).asin()
     }
 }
 

@@ -4,6 +4,7 @@ pub mod map;
 pub mod measure;
 pub mod output;
 pub mod simulate;
+pub mod synth;
 
 use clap::ValueEnum;
 use qrm::calculus::Calculus;

@@ -68,16 +68,14 @@ pub fn run(args: SynthArgs) -> Result<()> {
         },
         stereo: !args.mono,
     };
-    let stations = args
-        .preset
-        .layout(args.seed, request.counts)
-        .stations
-        .len();
+    let stations = args.preset.layout(args.seed, request.counts).stations.len();
     let bar = ProgressBar::new(stations as u64);
     bar.set_style(
-        ProgressStyle::with_template("{spinner} rendering [{bar:40}] {pos}/{len} stations ({elapsed}, eta {eta})")
-            .expect("static template")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "{spinner} rendering [{bar:40}] {pos}/{len} stations ({elapsed}, eta {eta})",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
     );
     let start = Instant::now();
     let truth = write_dataset(&args.out, &calib, request, &|| bar.inc(1))

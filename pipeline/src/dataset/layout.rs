@@ -76,7 +76,12 @@ impl Preset {
 }
 
 /// Rocks uniform in a `side` square, radii uniform in `sizes`, not overlapping.
-fn uniform_field(rng: &mut ChaCha8Rng, n: usize, side: f64, sizes: (f64, f64)) -> Vec<(Point, f64)> {
+fn uniform_field(
+    rng: &mut ChaCha8Rng,
+    n: usize,
+    side: f64,
+    sizes: (f64, f64),
+) -> Vec<(Point, f64)> {
     let mut rocks: Vec<(Point, f64)> = Vec::with_capacity(n);
     while rocks.len() < n {
         let r = rng.random_range(sizes.0..sizes.1);
@@ -90,7 +95,12 @@ fn uniform_field(rng: &mut ChaCha8Rng, n: usize, side: f64, sizes: (f64, f64)) -
 
 /// Half the rocks in `clusters` tight groups, the rest scattered (the Mars Yard's rock
 /// clusters, 000 Fig. 8), in a `side` square.
-fn clustered_field(rng: &mut ChaCha8Rng, n: usize, side: f64, clusters: usize) -> Vec<(Point, f64)> {
+fn clustered_field(
+    rng: &mut ChaCha8Rng,
+    n: usize,
+    side: f64,
+    clusters: usize,
+) -> Vec<(Point, f64)> {
     let centres: Vec<Point> = (0..clusters)
         .map(|_| {
             Point::new(
@@ -180,7 +190,12 @@ fn loop_traverse(rng: &mut ChaCha8Rng, rocks: &[(Point, f64)], side: f64, n: usi
 }
 
 /// A long meandering traverse across a `side` square.
-fn meander_traverse(rng: &mut ChaCha8Rng, rocks: &[(Point, f64)], side: f64, n: usize) -> Vec<Pose> {
+fn meander_traverse(
+    rng: &mut ChaCha8Rng,
+    rocks: &[(Point, f64)],
+    side: f64,
+    n: usize,
+) -> Vec<Pose> {
     let phase = rng.random_range(0.0..TAU);
     stops_along(rng, rocks, n, move |s| {
         let x = 0.1 * side + s * 0.9;

@@ -51,7 +51,9 @@ pub fn write_dataset(
     } else {
         &[(Eye::Mono, "mono")]
     };
-    let names: Vec<String> = (0..stations.len()).map(|i| format!("station_{i:03}")).collect();
+    let names: Vec<String> = (0..stations.len())
+        .map(|i| format!("station_{i:03}"))
+        .collect();
     let per_station: Vec<Vec<ImageTruth>> = stations
         .par_iter()
         .enumerate()
@@ -141,6 +143,9 @@ fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), Dat
 }
 
 fn temporary(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }

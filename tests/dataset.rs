@@ -1,0 +1,122 @@
+//! Synthetic datasets (issue 4) against their own geometry: what `truth.json` says each image
+//! shows agrees with the calibration — centroid columns with true bearings, ground-contact rows
+//! with ranges, left/right disparity with range and baseline — and the files are what the
+//! format promises.
+
+use qrm::calib::Calibration;
+use qrm::dataset::{write_dataset, Counts, Preset, Request, Truth, VisibleRock};
+
+fn calibration(scale: f64) -> Calibration {
+    let text = include_str!("../calib/default.toml");
+    let mut c = Calibration::parse(text, "default.toml").unwrap();
+    c.image.width = (f64::from(c.image.width) * scale) as u32;
+    c.image.height = (f64::from(c.image.height) * scale) as u32;
+    c.elevation.horizon_row *= scale;
+    c.elevation.focal_px *= scale;
+    c
+}
+
+fn render(preset: Preset, stations: usize, stereo: bool, name: &str) -> (Truth, Calibration) {
+    let dir = std::env::temp_dir().join(format!("qrm-dataset-{name}-{}", std::process::id()));
+    let calib = calibration(0.5);
+    let truth = write_dataset(
+        &dir,
+        &calib,
+        Request {
+            preset,
+            seed: 4,
+            counts: Counts {
+                rocks: None,
+                stations: Some(stations),
+            },
+            stereo,
+        },
+        &|| {},
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(dir.join("truth.json")).unwrap();
+    let reread: Truth = serde_json::from_str(&text).unwrap();
+    assert_eq!(reread, truth);
+    let reread_calib = Calibration::load(&dir.join("calib.toml")).unwrap();
+    assert_eq!(reread_calib, calib);
+    for image in &truth.images {
+        assert!(dir.join(&image.file).is_file(), "{}", image.file);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    (truth, calib)
+}
+
+/// Well-seen rocks: enough pixels that shape and pixel quantisation average out.
+fn well_seen(rock: &VisibleRock) -> bool {
+    rock.pixels >= 200
+}
+
+fn column_difference(a: f64, b: f64, width: f64) -> f64 {
+    let d = (a - b).rem_euclid(width);
+    d.min(width - d)
+}
+
+#[test]
+fn centroids_follow_bearings_and_contacts_follow_ranges() {
+    let (truth, calib) = render(Preset::Random, 4, false, "mono");
+    let width = f64::from(calib.image.width);
+    let mut checked = 0;
+    for image in &truth.images {
+        // Rocks whose ground contact falls below the image's bottom edge are cut off there.
+        let in_view = |r: &&VisibleRock| r.contact[1] < f64::from(calib.image.height) - 1.0;
+        for rock in image.rocks.iter().filter(|r| well_seen(r)).filter(in_view) {
+            // Irregular rocks: the visible centroid may sit off the ground position by a part
+            // of the rock's angular size.
+            let size = truth.rocks[rock.id as usize].size;
+            let angular = (size / rock.range).atan() / calib.column_width();
+            let off = column_difference(rock.centroid[0], rock.bearing_column, width);
+            assert!(
+                off <= 0.5 + 0.6 * angular,
+                "rock {} off by {off} px",
+                rock.id
+            );
+            // The lowest visible row is where the rock meets the ground nearest the camera,
+            // unless something nearer hides it.
+            let bottom = f64::from(rock.bbox[3]) + 1.0;
+            assert!(
+                (bottom - rock.contact[1]).abs()
+                    <= 2.0 + 0.2 * (bottom - calib.elevation.horizon_row),
+                "rock {} bottom {bottom} contact {}",
+                rock.id,
+                rock.contact[1]
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 10, "only {checked} rocks checked");
+}
+
+#[test]
+fn stereo_disparity_matches_range_and_baseline() {
+    let (truth, calib) = render(Preset::Marsyard, 3, true, "stereo");
+    let width = f64::from(calib.image.width);
+    let mut checked = 0;
+    for pair in truth.images.chunks(2) {
+        let (left, right) = (&pair[0], &pair[1]);
+        assert_eq!((left.eye.as_str(), right.eye.as_str()), ("left", "right"));
+        for l in left.rocks.iter().filter(|r| well_seen(r)) {
+            let Some(r) = right.rocks.iter().find(|r| r.id == l.id && well_seen(r)) else {
+                continue;
+            };
+            let measured =
+                column_difference(l.centroid[0], r.centroid[0], width) * calib.column_width();
+            let expected = calib.stereo_disparity(0.5 * (l.range + r.range));
+            // Near irregular rocks show each eye a different side: allow a tenth of the rock's
+            // angular size on top of 1.5 pixels.
+            let size = truth.rocks[l.id as usize].size;
+            let angular = 2.0 * (size / l.range).atan();
+            assert!(
+                (measured - expected).abs() <= 1.5 * calib.column_width() + 0.1 * angular,
+                "rock {}: disparity {measured} vs {expected}",
+                l.id
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 5, "only {checked} rocks checked");
+}
