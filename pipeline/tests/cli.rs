@@ -154,3 +154,65 @@ fn simulates_and_writes_outputs() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn synthesises_a_dataset_and_rejects_bad_calibrations() {
+    let dir = std::env::temp_dir().join(format!("qrm-cli-synth-{}", std::process::id()));
+    let o = run(&[
+        "synth",
+        "--preset",
+        "random",
+        "--stations",
+        "2",
+        "--mono",
+        "--scale",
+        "0.1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for file in [
+        "calib.toml",
+        "truth.json",
+        "station_000.png",
+        "station_001.png",
+    ] {
+        assert!(dir.join(file).is_file(), "{file}");
+    }
+    let bad = dir.join("bad.toml");
+    let text = std::fs::read_to_string(dir.join("calib.toml")).unwrap();
+    std::fs::write(&bad, text.replace("height_m", "height")).unwrap();
+    for args in [
+        vec![
+            "synth",
+            "--calib",
+            bad.to_str().unwrap(),
+            "--out",
+            "/tmp/never",
+        ],
+        vec![
+            "synth",
+            "--calib",
+            "/nonexistent/calib.toml",
+            "--out",
+            "/tmp/never",
+        ],
+        vec!["synth", "--scale", "0", "--out", "/tmp/never"],
+        vec!["synth", "--stations", "0", "--out", "/tmp/never"],
+    ] {
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.starts_with("error: "), "{args:?}: {err}");
+    }
+    let o = run(&[
+        "synth",
+        "--calib",
+        bad.to_str().unwrap(),
+        "--out",
+        "/tmp/never",
+    ]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("height_m"));
+    assert!(!std::path::Path::new("/tmp/never").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
