@@ -2,6 +2,7 @@
 //!
 //! Stages live in one module each; see `docs/ARCHITECTURE.md`.
 
+pub mod atomic_file;
 pub mod calculus;
 pub mod calib;
 pub mod dataset;

@@ -229,10 +229,15 @@ mod tests {
 
     #[test]
     fn traverse_stops_are_one_to_two_metres_apart() {
+        // Stops that would fall on a rock are skipped, so a few steps are longer.
         let layout = Preset::Marsyard.layout(3, Counts::default());
-        for w in layout.stations.windows(2) {
-            let d = w[0].position.distance(w[1].position);
-            assert!(d < 2.0 * 2.0 + 1e-9, "{d}");
-        }
+        let steps: Vec<f64> = layout
+            .stations
+            .windows(2)
+            .map(|w| w[0].position.distance(w[1].position))
+            .collect();
+        let regular = steps.iter().filter(|&&d| (0.9..=2.0).contains(&d)).count();
+        assert!(regular * 10 >= steps.len() * 8, "{steps:?}");
+        assert!(steps.iter().all(|&d| d <= 10.0), "{steps:?}");
     }
 }

@@ -4,7 +4,7 @@
 use super::layout::{Counts, Layout, Preset};
 use super::truth::{visible_rocks, ImageTruth, RockTruth, StationTruth, Truth, FORMAT, VERSION};
 use crate::calib::Calibration;
-use crate::synth::{render, Eye, World};
+use crate::synth::{render, Eye, Render, World};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -67,7 +67,7 @@ pub fn write_dataset(
                     } else {
                         format!("{}.png", names[i])
                     };
-                    write_png(&dir.join(&file), image.width, image.height, &image.rgb)?;
+                    write_png(&dir.join(&file), &image)?;
                     Ok(ImageTruth {
                         file,
                         station: i,
@@ -105,47 +105,27 @@ pub fn write_dataset(
     Ok(truth)
 }
 
-/// Writes through a temporary file beside `path`, then renames.
 fn write_file(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
-    let tmp = temporary(path);
-    std::fs::write(&tmp, bytes)
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .map_err(|source| {
-            let _ = std::fs::remove_file(&tmp);
-            DatasetError::Write {
-                path: path.to_path_buf(),
-                source,
-            }
-        })
-}
-
-fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), DatasetError> {
-    let tmp = temporary(path);
-    image::save_buffer_with_format(
-        &tmp,
-        rgb,
-        width,
-        height,
-        image::ColorType::Rgb8,
-        image::ImageFormat::Png,
-    )
-    .map_err(|source| {
-        let _ = std::fs::remove_file(&tmp);
-        DatasetError::Encode {
-            path: path.to_path_buf(),
-            source,
-        }
-    })?;
-    std::fs::rename(&tmp, path).map_err(|source| DatasetError::Write {
+    crate::atomic_file::write_bytes(path, bytes).map_err(|source| DatasetError::Write {
         path: path.to_path_buf(),
         source,
     })
 }
 
-fn temporary(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+fn write_png(path: &Path, image: &Render) -> Result<(), DatasetError> {
+    crate::atomic_file::write_via_temporary(
+        path,
+        |temporary| {
+            image
+                .save_png(temporary)
+                .map_err(|source| DatasetError::Encode {
+                    path: path.to_path_buf(),
+                    source,
+                })
+        },
+        |source| DatasetError::Write {
+            path: path.to_path_buf(),
+            source,
+        },
+    )
 }

@@ -8,8 +8,7 @@ use super::font;
 use plotters::coord::Shift;
 use plotters::prelude::{BitMapBackend, DrawingArea, DrawingAreaErrorKind, DrawingBackend};
 use plotters::prelude::{IntoDrawingArea, SVGBackend};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::path::Path;
 
 /// A figure that can draw itself on any plotters backend.
 pub(super) trait Figure {
@@ -43,13 +42,6 @@ impl Format {
             })
         }
     }
-
-    fn extension(self) -> &'static str {
-        match self {
-            Format::Png => "png",
-            Format::Svg => "svg",
-        }
-    }
 }
 
 /// Renders `figure` to `path` atomically. `path` must have a `.png` or `.svg` extension.
@@ -60,35 +52,14 @@ pub(super) fn write_figure(path: &Path, figure: &impl Figure) -> Result<(), Plot
             path: path.to_path_buf(),
         });
     }
-    let temporary = temporary_path(path, format);
-    let result = render(path, &temporary, format, figure).and_then(|()| {
-        std::fs::rename(&temporary, path).map_err(|source| PlotError::Io {
+    crate::atomic_file::write_via_temporary(
+        path,
+        |temporary| render(path, temporary, format, figure),
+        |source| PlotError::Io {
             path: path.to_path_buf(),
             source,
-        })
-    });
-    if result.is_err() {
-        // The temporary file may not exist (the error came before it was created); either way
-        // nothing is left behind, and the original error is the one worth reporting.
-        let _ = std::fs::remove_file(&temporary);
-    }
-    result
-}
-
-/// A name next to `path`, unique within this process and across processes, that keeps the
-/// extension (the bitmap encoder picks its format from it).
-fn temporary_path(path: &Path, format: Format) -> PathBuf {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(
-        ".{name}.{}-{}.tmp.{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed),
-        format.extension()
-    ))
+        },
+    )
 }
 
 /// Draws `figure` into the file `temporary`; errors name `path`, the file the caller asked for.

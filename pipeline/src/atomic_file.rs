@@ -1,0 +1,90 @@
+//! Files written whole or not at all: every output of the project (maps, figures, panoramas,
+//! truth files) is produced under a uniquely named temporary file beside its target, synced,
+//! and renamed over it; on failure the temporary file is removed. A reader — or a batch that
+//! crashed half-way — never sees a half-written file, and concurrent writers of the same target
+//! do not trample each other's temporary files.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Produces `path` by letting `write` fill a temporary file (whose name keeps `path`'s
+/// extension, for encoders that choose their format by it), then renaming it. `io_error` turns
+/// a failed sync or rename into the caller's error type.
+pub fn write_via_temporary<E>(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), E>,
+    io_error: impl FnOnce(std::io::Error) -> E,
+) -> Result<(), E> {
+    let temporary = temporary_path(path);
+    let result = write(&temporary).and_then(|()| {
+        std::fs::File::open(&temporary)
+            .and_then(|f| f.sync_all())
+            .and_then(|()| std::fs::rename(&temporary, path))
+            .map_err(io_error)
+    });
+    if result.is_err() {
+        // The temporary file may not exist (the error came before it was created); either way
+        // nothing is left behind, and the original error is the one worth reporting.
+        let _ = std::fs::remove_file(&temporary);
+    }
+    result
+}
+
+/// Writes `bytes` to `path` atomically.
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    write_via_temporary(
+        path,
+        |temporary| std::fs::File::create(temporary)?.write_all(bytes),
+        |e| e,
+    )
+}
+
+/// `.<name>.<pid>-<n>.tmp.<extension>` next to `path`.
+fn temporary_path(path: &Path) -> PathBuf {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(
+        ".{name}.{}-{}.tmp.{extension}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_whole_files_and_leaves_nothing_on_failure() {
+        let dir = std::env::temp_dir().join(format!("qrm-atomic-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let target = dir.join("a.txt");
+        write_bytes(&target, b"first").unwrap();
+        write_bytes(&target, b"second").unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"second");
+        let failed: Result<(), String> = write_via_temporary(
+            &dir.join("b.png"),
+            |temporary| {
+                assert_eq!(temporary.extension().unwrap(), "png");
+                std::fs::write(temporary, b"half").unwrap();
+                Err("encoder failed".to_string())
+            },
+            |e| e.to_string(),
+        );
+        assert_eq!(failed, Err("encoder failed".to_string()));
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        assert_eq!(names, ["a.txt"]);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
