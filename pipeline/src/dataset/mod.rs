@@ -8,7 +8,6 @@ mod writer;
 
 pub use layout::{Counts, Layout, Preset};
 pub use truth::{
-    contact_radius, optical_centre, visible_rocks, ImageTruth, LumpTruth, RockTruth, StationTruth,
-    Truth, VisibleRock,
+    visible_rocks, ImageTruth, LumpTruth, RockTruth, StationTruth, Truth, VisibleRock,
 };
 pub use writer::{write_dataset, DatasetError, Request};

@@ -2,8 +2,7 @@
 //! evaluation reads it; the pipeline proper never does.
 
 use crate::calib::Calibration;
-use crate::geometry::Point;
-use crate::synth::{Eye, Pose, Render, World};
+use crate::synth::{optical_centre, Eye, Pose, Render, World};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -113,42 +112,6 @@ impl RockTruth {
     }
 }
 
-/// The optical centre of `eye` for a column looking along world azimuth `azimuth`.
-pub fn optical_centre(calib: &Calibration, pose: Pose, eye: Eye, azimuth: f64) -> Point {
-    let offset = match eye {
-        Eye::Mono => 0.0,
-        Eye::Left => calib.stereo.baseline_m / 2.0,
-        Eye::Right => -calib.stereo.baseline_m / 2.0,
-    };
-    // Left of the viewing direction is +90°.
-    Point::new(
-        pose.position.x - offset * azimuth.sin(),
-        pose.position.y + offset * azimuth.cos(),
-    )
-}
-
-/// Horizontal radius of the rock's footprint on the ground plane in direction `(dx, dy)` (unit):
-/// the support function of the lumps' cross-sections at z = 0.
-pub fn contact_radius(world: &World, id: u32, dx: f64, dy: f64) -> f64 {
-    let rock = &world.rocks[id as usize];
-    rock.lumps
-        .iter()
-        .filter_map(|l| {
-            let z = l.center[2] - rock.burial;
-            let t = z / l.radii[2];
-            if t.abs() >= 1.0 {
-                return None;
-            }
-            let scale = (1.0 - t * t).sqrt();
-            let (a, b) = (l.radii[0] * scale, l.radii[1] * scale);
-            // Direction in the lump's frame (rotated by −yaw).
-            let (c, s) = (l.yaw.cos(), l.yaw.sin());
-            let (u, v) = (c * dx + s * dy, -s * dx + c * dy);
-            Some((a * u).hypot(b * v) + l.center[0] * dx + l.center[1] * dy)
-        })
-        .fold(0.0, f64::max)
-}
-
 /// What image `render` of `world` from `pose` shows of each rock.
 pub fn visible_rocks(
     world: &World,
@@ -213,7 +176,7 @@ pub fn visible_rocks(
         let range = dx.hypot(dy);
         let bearing = (dy.atan2(dx) - pose.heading).rem_euclid(std::f64::consts::TAU);
         let bearing_column = calib.column(bearing);
-        let contact = range - contact_radius(world, id, dx / range, dy / range);
+        let contact = range - world.contact_reach(id, dx / range, dy / range);
         out.push(VisibleRock {
             id,
             pixels: a.pixels,

@@ -16,5 +16,5 @@ mod shade;
 mod shadow;
 mod world;
 
-pub use render::{render, Eye, Pose, Render};
+pub use render::{optical_centre, render, Eye, Pose, Render};
 pub use world::{Lump, Rock, World};

@@ -54,6 +54,21 @@ struct Candidate {
     rows: (f64, f64),
 }
 
+/// The optical centre (on the ground plane's x, y) of `eye` for the column looking along world
+/// azimuth `azimuth`: the rotating stereo head puts the left camera baseline/2 to the left of
+/// the viewing direction and the right camera baseline/2 to its right.
+pub fn optical_centre(calib: &Calibration, pose: Pose, eye: Eye, azimuth: f64) -> Point {
+    let offset = match eye {
+        Eye::Mono => 0.0,
+        Eye::Left => 0.5 * calib.stereo.baseline_m,
+        Eye::Right => -0.5 * calib.stereo.baseline_m,
+    };
+    Point::new(
+        pose.position.x - offset * azimuth.sin(),
+        pose.position.y + offset * azimuth.cos(),
+    )
+}
+
 /// Renders one panorama: each column is a ray fan at that column's azimuth; for Left/Right the
 /// optical centre is displaced ±baseline/2 perpendicular to that column's viewing direction
 /// (left eye to the left of the viewing direction), at height mast.height_m above the ground
@@ -62,22 +77,14 @@ pub fn render(world: &World, calib: &Calibration, pose: Pose, eye: Eye) -> Rende
     let scene = Scene::new(world);
     let shadows = Shadows::new(&scene);
     let (width, height) = (calib.image.width as usize, calib.image.height as usize);
-    let offset = match eye {
-        Eye::Mono => 0.0,
-        Eye::Left => 0.5 * calib.stereo.baseline_m,
-        Eye::Right => -0.5 * calib.stereo.baseline_m,
-    };
     let mast = calib.mast.height_m;
     let mut candidates = Vec::new();
     let columns: Vec<Column> = (0..width)
         .map(|c| {
             let azimuth = pose.heading + calib.azimuth(c as f64 + 0.5);
             let along = [azimuth.cos(), azimuth.sin()];
-            let origin = [
-                pose.position.x - offset * along[1],
-                pose.position.y + offset * along[0],
-                mast,
-            ];
+            let centre = optical_centre(calib, pose, eye, azimuth);
+            let origin = [centre.x, centre.y, mast];
             let start = candidates.len();
             for (body, b) in scene.bodies.iter().enumerate() {
                 if let Some(rows) = rows_of_sphere(calib, origin, along, b.center, b.radius) {

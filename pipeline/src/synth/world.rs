@@ -106,6 +106,32 @@ impl World {
             .fold(0.0, f64::max)
     }
 
+    /// How far the rock's footprint on the ground plane reaches from its position in the
+    /// horizontal unit direction `(dx, dy)`: the support function of the lumps' cross-sections
+    /// at z = 0. Toward the camera this puts the near ground contact at `range − reach`
+    /// (truth files); [`World::contact_radius`] is its maximum over directions, roughly.
+    ///
+    /// # Panics
+    /// If no rock has this id.
+    pub fn contact_reach(&self, id: u32, dx: f64, dy: f64) -> f64 {
+        let rock = self.rock(id);
+        rock.lumps
+            .iter()
+            .filter_map(|l| {
+                let t = (l.center[2] - rock.burial) / l.radii[2];
+                if t.abs() >= 1.0 {
+                    return None;
+                }
+                let scale = (1.0 - t * t).sqrt();
+                let (a, b) = (l.radii[0] * scale, l.radii[1] * scale);
+                // The direction in the lump's frame (turned by −yaw).
+                let (c, s) = (l.yaw.cos(), l.yaw.sin());
+                let (u, v) = (c * dx + s * dy, -s * dx + c * dy);
+                Some((a * u).hypot(b * v) + l.center[0] * dx + l.center[1] * dy)
+            })
+            .fold(0.0, f64::max)
+    }
+
     fn rock(&self, id: u32) -> &Rock {
         self.rocks
             .iter()
