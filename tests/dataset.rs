@@ -8,12 +8,10 @@ use qrm::dataset::{write_dataset, Counts, Preset, Request, Truth, VisibleRock};
 
 fn calibration(scale: f64) -> Calibration {
     let text = include_str!("../calib/default.toml");
-    let mut c = Calibration::parse(text, "default.toml").unwrap();
-    c.image.width = (f64::from(c.image.width) * scale) as u32;
-    c.image.height = (f64::from(c.image.height) * scale) as u32;
-    c.elevation.horizon_row *= scale;
-    c.elevation.focal_px *= scale;
-    c
+    Calibration::parse(text, "default.toml")
+        .unwrap()
+        .scaled(scale)
+        .unwrap()
 }
 
 fn render(preset: Preset, stations: usize, stereo: bool, name: &str) -> (Truth, Calibration) {

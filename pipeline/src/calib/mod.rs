@@ -113,6 +113,18 @@ impl Calibration {
         Ok(calibration)
     }
 
+    /// The same camera at `factor` times the image size (focal length and horizon row scaled
+    /// with it), for quick low-resolution sets; checked like a file.
+    pub fn scaled(&self, factor: f64) -> Result<Calibration, CalibrationError> {
+        let mut c = *self;
+        c.image.width = (f64::from(c.image.width) * factor).round() as u32;
+        c.image.height = (f64::from(c.image.height) * factor).round() as u32;
+        c.elevation.horizon_row *= factor;
+        c.elevation.focal_px *= factor;
+        c.check(&format!("the calibration scaled by {factor}"))?;
+        Ok(c)
+    }
+
     /// The calibration as TOML (what [`Calibration::parse`] reads back).
     pub fn to_toml(&self) -> String {
         toml::to_string(self).expect("plain numbers serialise")

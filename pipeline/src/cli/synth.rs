@@ -47,11 +47,7 @@ pub fn run(args: SynthArgs) -> Result<()> {
         bail!("--scale {} must lie in [0.01, 4]", args.scale);
     }
     if args.scale != 1.0 {
-        calib.image.width = (f64::from(calib.image.width) * args.scale).round() as u32;
-        calib.image.height = (f64::from(calib.image.height) * args.scale).round() as u32;
-        calib.elevation.horizon_row *= args.scale;
-        calib.elevation.focal_px *= args.scale;
-        calib = Calibration::parse(&calib.to_toml(), "the scaled calibration")?;
+        calib = calib.scaled(args.scale)?;
     }
     if args.rocks == Some(0) || args.stations == Some(0) {
         bail!("--rocks and --stations must be positive");
