@@ -16,5 +16,6 @@ pub mod measurement;
 pub mod metrics;
 pub mod neighborhood;
 pub mod plot;
+pub mod run;
 pub mod simulation;
 pub mod synth;

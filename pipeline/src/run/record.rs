@@ -1,0 +1,116 @@
+//! What `pipeline run` reports about each panorama: the record every output (`run.mcap`, the
+//! rerun recording, the summary) is written from. Plain data, serialised as JSON; the field
+//! meanings are documented in `docs/RUN.md`.
+
+use serde::{Deserialize, Serialize};
+
+/// Everything the run learned from one station's panorama(s).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StationRecord {
+    /// Position of the station in the run, from 0.
+    pub index: usize,
+    /// Station name (the image file name without `_left`/`_right` and extension).
+    pub station: String,
+    /// Image files read for this station (left first), relative to the image directory.
+    pub files: Vec<String>,
+    /// Detections in the primary (left or mono) panorama, in column order.
+    pub detections: Vec<DetectionRecord>,
+    /// The asserted "nearer than" pairs `(i, j)`: detection `i` is nearer than detection `j`.
+    pub order: Vec<(usize, usize)>,
+    /// The outcome of fusing this panorama into the map.
+    pub fusion: FusionRecord,
+    /// The map after this panorama.
+    pub metrics: MetricsRecord,
+    /// Wall time of each stage for this station, seconds.
+    pub seconds: StageSeconds,
+    /// Warnings about this station (skipped images, too few detections, …).
+    pub warnings: Vec<String>,
+}
+
+/// One detection, its bearing, its range evidence and what association decided.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DetectionRecord {
+    /// `[col_min, row_min, col_max, row_max]`, inclusive; `col_max ≥ width` when it wraps.
+    pub bbox: [u32; 4],
+    /// Centroid `(column, row)` in the primary panorama.
+    pub centroid: [f64; 2],
+    /// Row of the ground contact.
+    pub contact_row: f64,
+    pub pixels: u32,
+    /// Centroid column of the matched detection in the right panorama, if any.
+    pub stereo_column: Option<f64>,
+    /// Bearing from the station centre, radians counter-clockwise from the calibration's zero.
+    pub bearing: f64,
+    /// Half-width of the bearing interval, radians.
+    pub bearing_uncertainty: f64,
+    /// Range intervals (metres) from each cue that applied, and their fusion.
+    pub range: RangeRecord,
+    pub association: Association,
+}
+
+/// Range evidence for one detection: `[low, high]` in metres; `high` may be infinite.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RangeRecord {
+    pub ground: Option<[f64; 2]>,
+    pub stereo: Option<[f64; 2]>,
+    pub size: Option<[f64; 2]>,
+    pub fused: [f64; 2],
+    /// The cues' intervals did not overlap; `fused` is then their hull.
+    pub conflict: bool,
+}
+
+/// What data association decided for one detection (000 §VI-C).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "decision", rename_all = "snake_case")]
+pub enum Association {
+    /// The detection is map landmark `landmark`.
+    Matched { landmark: u32 },
+    /// No landmark is consistent with it: a new landmark.
+    New { landmark: u32 },
+    /// Several landmarks remain possible: the observation is held back.
+    HeldBack { candidates: Vec<u32> },
+    /// Not used for mapping (e.g. the panorama was rejected).
+    #[default]
+    Unused,
+}
+
+/// The outcome of fusing one panorama.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FusionRecord {
+    /// Landmarks whose triples were measured.
+    pub landmarks: usize,
+    /// Triples measured.
+    pub triples: usize,
+    /// Relations the update tightened.
+    pub relations_tightened: usize,
+    /// Held-back observations of earlier panoramas resolved and fused at this station.
+    pub resolved_held_back: usize,
+    /// Why the map rejected the panorama, if it did.
+    pub contradiction: Option<String>,
+}
+
+/// The map after a panorama.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MetricsRecord {
+    pub landmarks: usize,
+    pub triples: usize,
+    /// Open states, fraction of all states of the map's triples.
+    pub open_fraction: f64,
+    /// Triples whose three relations are single states, fraction of the map's triples.
+    pub fully_constrained_fraction: f64,
+    /// RNG edges the map proves (cost 0), and edges still uncertain.
+    pub rng_certain: usize,
+    pub rng_uncertain: usize,
+    /// `Σ w_ij` of Algorithm 2.
+    pub rng_cost: f64,
+}
+
+/// Wall time per stage, seconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StageSeconds {
+    pub decode: f64,
+    pub detect: f64,
+    pub range: f64,
+    pub associate: f64,
+    pub map: f64,
+}
