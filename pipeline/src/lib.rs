@@ -2,11 +2,14 @@
 //!
 //! Stages live in one module each; see `docs/ARCHITECTURE.md`.
 
+pub mod association;
 pub mod atomic_file;
 pub mod calculus;
 pub mod calib;
 pub mod dataset;
+pub mod detection;
 pub mod edc;
+pub mod evaluation;
 pub mod fdc;
 pub mod feasibility;
 pub mod generation;
@@ -16,6 +19,8 @@ pub mod measurement;
 pub mod metrics;
 pub mod neighborhood;
 pub mod plot;
+pub mod ranging;
 pub mod run;
 pub mod simulation;
+pub mod survey;
 pub mod synth;

@@ -78,6 +78,11 @@ enum Command {
     /// Render a synthetic dataset: stereo panoramas of a rock field with ground truth
     /// (datasets/README.md), e.g. `synth --preset marsyard --seed 1 --out data/marsyard`.
     Synth(cli::synth::SynthArgs),
+    /// Map a directory of panoramas: detect rocks, bearings, range order, associate, fuse,
+    /// RNG (docs/RUN.md), e.g. `run --images datasets/demo --out demo-run`.
+    Run(cli::run::RunArgs),
+    /// Score a run against the dataset's truth.json (docs/RUN.md).
+    Eval(cli::eval::EvalArgs),
 }
 
 fn parse_point(text: &str) -> Result<Point> {
@@ -208,6 +213,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Simulate(command) => cli::simulate::run_command(command)?,
         Command::Map(command) => cli::map::run_command(command)?,
         Command::Synth(args) => cli::synth::run(args)?,
+        Command::Run(args) => cli::run::run(args)?,
+        Command::Eval(args) => cli::eval::run(args)?,
     }
     Ok(())
 }

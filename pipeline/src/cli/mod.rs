@@ -1,8 +1,10 @@
 //! Subcommands of the `pipeline` binary beyond the calculus tools in `main.rs`.
 
+pub mod eval;
 pub mod map;
 pub mod measure;
 pub mod output;
+pub mod run;
 pub mod simulate;
 pub mod synth;
 

@@ -9,6 +9,7 @@
 mod cost_colour;
 mod error;
 mod font;
+mod layout;
 mod legend;
 mod output;
 mod palette;
@@ -17,6 +18,7 @@ mod rng;
 mod ticks;
 
 pub use error::PlotError;
+pub use layout::spring_layout;
 pub use panels::{write_panels, Curve, Panel};
 pub use rng::{write_rng, RngPicture};
 

@@ -1,0 +1,306 @@
+//! Data association (000 §VI-C): which map landmark, if any, each detection of a station is.
+//!
+//! Appearance proposes, the qualitative map decides:
+//! 1. the [`Gallery`] proposes, for each detection, the landmarks whose descriptor and
+//!    physical width are close enough;
+//! 2. **anchors** are mutual, clearly-best proposals; they are checked against each other: a
+//!    triple of anchors whose measured states do not overlap the map's is inconsistent, and
+//!    the anchor in most such triples is dropped until none is left;
+//! 3. every other proposal is tested as 000 §VI-C describes: the detection's triples with
+//!    pairs of anchors are measured and compared with the candidate landmark's relations in
+//!    the map; a candidate with an empty overlap in any relation is rejected;
+//! 4. no candidate left → a new landmark; one left, on evidence the map actually constrains
+//!    → matched; otherwise the observation is **held back** and tried again when the map is
+//!    tighter. Nothing is fused on a guess.
+
+mod gallery;
+
+pub use gallery::{distance, AppearanceScales, Gallery, Profile};
+
+use crate::calculus::Calculus;
+use crate::detection::Appearance;
+use crate::map::{Hypergraph, LandmarkId};
+use crate::measurement::Panorama;
+use crate::ranging::RangeInterval;
+use serde::{Deserialize, Serialize};
+
+/// Thresholds of association.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AssociationSettings {
+    pub scales: AppearanceScales,
+    /// Largest descriptor distance of a candidate.
+    pub gate: f64,
+    /// An anchor's distance must be below this fraction of the runner-up's.
+    pub ratio: f64,
+    /// Triples a single surviving candidate must have been tested on, with relations the map
+    /// constrains, before it is taken without appearance backing.
+    pub informative_triples: usize,
+    /// Most anchor pairs tested per candidate (the most constrained first).
+    pub tested_pairs: usize,
+}
+
+impl Default for AssociationSettings {
+    fn default() -> AssociationSettings {
+        AssociationSettings {
+            scales: AppearanceScales::default(),
+            gate: 4.0,
+            ratio: 0.6,
+            informative_triples: 6,
+            tested_pairs: 40,
+        }
+    }
+}
+
+/// What one detection needs for association.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Evidence {
+    pub appearance: Appearance,
+    /// Physical width bounds from this station's range evidence.
+    pub width: Option<RangeInterval>,
+}
+
+/// The association decision for one detection.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Decision {
+    Matched(LandmarkId),
+    New,
+    HeldBack(Vec<LandmarkId>),
+}
+
+/// Associates the detections of one station (`panorama` holds their bearings and range order,
+/// `evidence` their looks, both indexed alike).
+pub fn associate<C: Calculus>(
+    map: &Hypergraph<C>,
+    gallery: &Gallery,
+    panorama: &Panorama,
+    evidence: &[Evidence],
+    settings: &AssociationSettings,
+) -> Vec<Decision> {
+    let n = evidence.len();
+    if gallery.is_empty() {
+        return vec![Decision::New; n];
+    }
+    let candidates: Vec<Vec<(LandmarkId, f64)>> = evidence
+        .iter()
+        .map(|e| proposals(e, gallery, settings))
+        .collect();
+    let mut anchors = anchor_proposals(&candidates, settings);
+    drop_inconsistent_anchors(map, panorama, &mut anchors);
+    let anchored: Vec<(usize, LandmarkId)> = anchors.iter().map(|a| (a.0, a.1)).collect();
+
+    let mut decisions: Vec<Decision> = (0..n)
+        .map(|i| match anchored.iter().find(|a| a.0 == i) {
+            Some(&(_, landmark)) => Decision::Matched(landmark),
+            None => decide(map, panorama, i, &candidates[i], &anchored, settings),
+        })
+        .collect();
+    // Two detections may not be one landmark: hold both back.
+    for i in 0..n {
+        if let Decision::Matched(l) = decisions[i] {
+            let clash: Vec<usize> = (0..n)
+                .filter(|&j| j != i && decisions[j] == Decision::Matched(l))
+                .collect();
+            if !clash.is_empty() && !anchored.iter().any(|a| a.0 == i) {
+                decisions[i] = Decision::HeldBack(vec![l]);
+            }
+        }
+    }
+    decisions
+}
+
+/// Re-decides one detection of an earlier station against the current map (held-back
+/// observations, 000 §VI-C "delayed until the map has converged further"). `decided` are the
+/// other detections of that station with their landmarks.
+pub fn reconsider<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    detection: usize,
+    candidates: &[LandmarkId],
+    decided: &[(usize, LandmarkId)],
+    settings: &AssociationSettings,
+) -> Decision {
+    let open: Vec<(LandmarkId, f64)> = candidates
+        .iter()
+        .filter(|l| !decided.iter().any(|d| d.1 == **l))
+        .map(|&l| (l, settings.gate))
+        .collect();
+    decide(map, panorama, detection, &open, decided, settings)
+}
+
+/// Landmarks whose looks are within the gate, nearest first.
+fn proposals(
+    evidence: &Evidence,
+    gallery: &Gallery,
+    settings: &AssociationSettings,
+) -> Vec<(LandmarkId, f64)> {
+    let mut out: Vec<(LandmarkId, f64)> = gallery
+        .profiles
+        .iter()
+        .filter(|p| match (p.width, evidence.width) {
+            (Some(a), Some(b)) => a.intersection(b).is_some(),
+            _ => true,
+        })
+        .map(|p| {
+            (
+                p.landmark,
+                distance(&evidence.appearance, &p.appearance, &settings.scales),
+            )
+        })
+        .filter(|&(_, d)| d <= settings.gate)
+        .collect();
+    out.sort_by(|a, b| a.1.total_cmp(&b.1));
+    out
+}
+
+/// Mutual best proposals that clearly beat the runner-up on both sides: `(detection,
+/// landmark, distance)`.
+fn anchor_proposals(
+    candidates: &[Vec<(LandmarkId, f64)>],
+    settings: &AssociationSettings,
+) -> Vec<(usize, LandmarkId, f64)> {
+    let clear = |best: f64, second: Option<f64>| second.is_none_or(|s| best < settings.ratio * s);
+    candidates
+        .iter()
+        .enumerate()
+        .filter_map(|(i, list)| {
+            let &(landmark, d) = list.first()?;
+            if !clear(d, list.get(1).map(|c| c.1)) {
+                return None;
+            }
+            // The landmark's other claimants must be clearly worse.
+            let rival = candidates
+                .iter()
+                .enumerate()
+                .filter(|&(j, _)| j != i)
+                .filter_map(|(_, l)| l.iter().find(|c| c.0 == landmark).map(|c| c.1))
+                .min_by(f64::total_cmp);
+            clear(d, rival).then_some((i, landmark, d))
+        })
+        .collect()
+}
+
+/// Whether the measured states of detections `[a, b, c]` overlap the map's relations of
+/// landmarks `ids`, and whether the map constrained them at all. `None` when the map has
+/// nothing on this triple.
+fn triple_consistency<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    detections: [usize; 3],
+    ids: [LandmarkId; 3],
+) -> Option<bool> {
+    let [a, b, c] = ids;
+    let open = [
+        map.relation(a, b, c)?,
+        map.relation(b, c, a)?,
+        map.relation(c, a, b)?,
+    ];
+    if open.iter().all(|r| *r == C::universe()) {
+        return None;
+    }
+    let measured = panorama.measure_triple::<C>(detections, open);
+    Some(measured.iter().all(|r| !r.is_empty()))
+}
+
+/// Drops anchors until every triple of anchors the map knows is consistent.
+fn drop_inconsistent_anchors<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    anchors: &mut Vec<(usize, LandmarkId, f64)>,
+) {
+    loop {
+        let k = anchors.len();
+        let mut failures = vec![0usize; k];
+        for x in 0..k {
+            for y in x + 1..k {
+                for z in y + 1..k {
+                    let (p, q, r) = (anchors[x], anchors[y], anchors[z]);
+                    if triple_consistency(map, panorama, [p.0, q.0, r.0], [p.1, q.1, r.1])
+                        == Some(false)
+                    {
+                        failures[x] += 1;
+                        failures[y] += 1;
+                        failures[z] += 1;
+                    }
+                }
+            }
+        }
+        // The worst offender, the weaker appearance match on ties.
+        let worst = (0..k)
+            .filter(|&i| failures[i] > 0)
+            .max_by(|&i, &j| {
+                failures[i]
+                    .cmp(&failures[j])
+                    .then(anchors[i].2.total_cmp(&anchors[j].2))
+            });
+        match worst {
+            Some(i) => {
+                anchors.remove(i);
+            }
+            None => return,
+        }
+    }
+}
+
+/// 000 §VI-C for one detection: candidates inconsistent with the map are rejected.
+fn decide<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    detection: usize,
+    candidates: &[(LandmarkId, f64)],
+    anchors: &[(usize, LandmarkId)],
+    settings: &AssociationSettings,
+) -> Decision {
+    let taken = |l: LandmarkId| anchors.iter().any(|a| a.1 == l);
+    let mut survivors: Vec<(LandmarkId, usize)> = Vec::new();
+    for &(landmark, _) in candidates.iter().filter(|c| !taken(c.0)) {
+        match test_candidate(map, panorama, detection, landmark, anchors, settings) {
+            Some(informative) => survivors.push((landmark, informative)),
+            None => continue,
+        }
+    }
+    match survivors.as_slice() {
+        [] => Decision::New,
+        [(landmark, informative)] if *informative >= settings.informative_triples => {
+            Decision::Matched(*landmark)
+        }
+        _ => Decision::HeldBack(survivors.iter().map(|s| s.0).collect()),
+    }
+}
+
+/// `None` if `landmark` is inconsistent with the detection's triples with the anchors;
+/// otherwise the number of triples on which the map constrained the test.
+fn test_candidate<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    detection: usize,
+    landmark: LandmarkId,
+    anchors: &[(usize, LandmarkId)],
+    settings: &AssociationSettings,
+) -> Option<usize> {
+    // The pairs on which the map knows most about the candidate first.
+    let mut pairs: Vec<(usize, usize, u32)> = Vec::new();
+    for x in 0..anchors.len() {
+        for y in x + 1..anchors.len() {
+            let (p, q) = (anchors[x], anchors[y]);
+            if let Some(r) = map.relation(landmark, p.1, q.1) {
+                let open = r.len() as u32
+                    + map.relation(p.1, q.1, landmark).map_or(0, |s| s.len() as u32)
+                    + map.relation(q.1, landmark, p.1).map_or(0, |s| s.len() as u32);
+                if open < 3 * C::universe().len() as u32 {
+                    pairs.push((x, y, open));
+                }
+            }
+        }
+    }
+    pairs.sort_by_key(|p| p.2);
+    let mut informative = 0;
+    for &(x, y, _) in pairs.iter().take(settings.tested_pairs) {
+        let (p, q) = (anchors[x], anchors[y]);
+        match triple_consistency(map, panorama, [detection, p.0, q.0], [landmark, p.1, q.1]) {
+            Some(false) => return None,
+            Some(true) => informative += 1,
+            None => {}
+        }
+    }
+    Some(informative)
+}

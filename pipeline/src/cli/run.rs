@@ -1,0 +1,188 @@
+//! `pipeline run --images DIR`: panoramas in, qualitative map and RNG out (docs/RUN.md).
+
+use super::output::write_atomic;
+use super::rng_json;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use qrm::association::AssociationSettings;
+use qrm::calib::Calibration;
+use qrm::detection::DetectorSettings;
+use qrm::edc::Edc;
+use qrm::neighborhood::estimate;
+use qrm::plot::{spring_layout, write_rng, RngPicture};
+use qrm::ranging::SensorModel;
+use qrm::run::front_end::{detect_station, FrontEndResult};
+use qrm::run::{Mapper, RunSummary, StationRecord};
+use qrm::survey::Survey;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Directory of panoramas: NAME_left/NAME_right pairs (stereo) or single images (mono).
+    #[arg(long)]
+    pub images: PathBuf,
+    /// Camera calibration (default: calib.toml in the image directory).
+    #[arg(long)]
+    pub calib: Option<PathBuf>,
+    /// Output directory (created if missing).
+    #[arg(long, default_value = "qrm-run")]
+    pub out: PathBuf,
+    /// Score the run against this ground truth (default: truth.json in the image directory,
+    /// if present).
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
+    /// Do not score against truth.json even if the image directory has one.
+    #[arg(long)]
+    pub no_eval: bool,
+}
+
+fn bar(len: usize, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len as u64);
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{{spinner}} {what:<9} [{{bar:40}}] {{pos}}/{{len}} ({{elapsed}}, eta {{eta}})"
+        ))
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar
+}
+
+pub fn run(args: RunArgs) -> Result<()> {
+    let started = Instant::now();
+    let survey = Survey::open(&args.images)?;
+    let calib_path = args
+        .calib
+        .clone()
+        .unwrap_or_else(|| args.images.join("calib.toml"));
+    if !calib_path.exists() {
+        bail!(
+            "no calibration: {} does not exist (give one with --calib FILE; format in calib/README.md)",
+            calib_path.display()
+        );
+    }
+    let calib = Calibration::load(&calib_path)?;
+    for path in &survey.unpaired {
+        eprintln!(
+            "warning: {} has no _left partner and is not used",
+            path.display()
+        );
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
+
+    let detector = DetectorSettings::default();
+    let progress = bar(survey.stations.len(), "detect");
+    let front: Vec<FrontEndResult> = survey
+        .stations
+        .par_iter()
+        .map(|station| {
+            let result = detect_station(station, &survey.directory, &calib, &detector);
+            progress.inc(1);
+            result
+        })
+        .collect();
+    progress.finish_and_clear();
+    let detect_wall = started.elapsed().as_secs_f64();
+
+    let mut mapper: Mapper<Edc> =
+        Mapper::new(calib, SensorModel::default(), AssociationSettings::default());
+    let mut records: Vec<StationRecord> = Vec::new();
+    let mut skipped = Vec::new();
+    let progress = bar(front.len(), "map");
+    let map_started = Instant::now();
+    for result in &front {
+        progress.inc(1);
+        let station = match &result.station {
+            Ok(station) => station,
+            Err(warning) => {
+                progress.suspend(|| eprintln!("warning: {warning}"));
+                skipped.push(warning.clone());
+                continue;
+            }
+        };
+        let mut record = mapper.process(records.len(), station);
+        record.seconds.decode = result.decode_seconds;
+        record.seconds.detect = result.detect_seconds;
+        for warning in &record.warnings {
+            progress.suspend(|| eprintln!("warning: {warning}"));
+        }
+        records.push(record);
+    }
+    progress.finish_and_clear();
+    if records.is_empty() {
+        bail!(
+            "none of the {} stations in {} could be read; nothing was written",
+            survey.stations.len(),
+            survey.directory.display()
+        );
+    }
+    let map_wall = map_started.elapsed().as_secs_f64();
+
+    write_outputs(&args.out, &mapper, &records)?;
+    let summary = RunSummary::of(&records, &mapper, skipped.len(), detect_wall, map_wall);
+    write_atomic(
+        &args.out.join("summary.json"),
+        (serde_json::to_string_pretty(&summary)? + "\n").as_bytes(),
+    )?;
+    println!("{summary}");
+    println!("total {:.2} s; outputs in {}", started.elapsed().as_secs_f64(), args.out.display());
+    println!("  look at {} (the RNG) and {} (the map, docs/MAP_FORMAT.md)",
+        args.out.join("rng.png").display(),
+        args.out.join("map.json").display());
+
+    let truth = args.truth.clone().or_else(|| {
+        let default = args.images.join("truth.json");
+        default.exists().then_some(default)
+    });
+    if let (Some(truth), false) = (truth, args.no_eval) {
+        super::eval::evaluate_run(&args.out, &truth, &args.out)?;
+    }
+    Ok(())
+}
+
+/// map.json, rng.json, rng.png, stations.json, landmarks.json.
+fn write_outputs(out: &Path, mapper: &Mapper<Edc>, records: &[StationRecord]) -> Result<()> {
+    write_atomic(&out.join("map.json"), mapper.map.to_json().as_bytes())?;
+    let rng = estimate(&mapper.map).expect("EDC has a lune");
+    write_atomic(&out.join("rng.json"), rng_json(&mapper.map, &rng).as_bytes())?;
+    let ids = mapper.map.landmarks();
+    let index = |id: u32| ids.iter().position(|&l| l == id).expect("edge of the map");
+    let edges: Vec<(usize, usize, f64)> = rng
+        .edges
+        .iter()
+        .map(|e| (index(e.a), index(e.b), e.cost))
+        .collect();
+    if !ids.is_empty() {
+        let layout = spring_layout(
+            ids.len(),
+            &edges.iter().map(|e| (e.0, e.1)).collect::<Vec<_>>(),
+        );
+        write_rng(
+            &out.join("rng.png"),
+            &RngPicture {
+                title: format!(
+                    "RNG after {} stations ({} landmarks; graph layout, not metric)",
+                    records.len(),
+                    ids.len()
+                ),
+                landmarks: &layout,
+                edges: &edges,
+                true_edges: &[],
+                stations: &[],
+            },
+        )?;
+    }
+    write_atomic(
+        &out.join("stations.json"),
+        (serde_json::to_string(records)? + "\n").as_bytes(),
+    )?;
+    write_atomic(
+        &out.join("landmarks.json"),
+        (serde_json::to_string_pretty(&mapper.landmarks())? + "\n").as_bytes(),
+    )?;
+    Ok(())
+}

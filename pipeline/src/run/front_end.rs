@@ -1,0 +1,95 @@
+//! The vision half of `pipeline run`: decode a station's panoramas and detect rocks in them.
+//! A bad primary image costs the station (with a warning); a bad right image only the stereo
+//! cue.
+
+use crate::calib::Calibration;
+use crate::detection::{detect, DetectorSettings};
+use crate::ranging::PrimaryEye;
+use crate::run::StationDetections;
+use crate::survey::{read_image, Station};
+use std::path::Path;
+use std::time::Instant;
+
+/// A station's detections with the decode and detection times (seconds, summed over its
+/// images), or the reason it cannot be used.
+pub struct FrontEndResult {
+    pub station: Result<StationDetections, String>,
+    pub decode_seconds: f64,
+    pub detect_seconds: f64,
+}
+
+/// Decodes and detects one station.
+pub fn detect_station(
+    station: &Station,
+    directory: &Path,
+    calib: &Calibration,
+    settings: &DetectorSettings,
+) -> FrontEndResult {
+    let size = (calib.image.width, calib.image.height);
+    let name = |p: &Path| {
+        p.strip_prefix(directory)
+            .unwrap_or(p)
+            .display()
+            .to_string()
+    };
+    let mut decode_seconds = 0.0;
+    let mut detect_seconds = 0.0;
+    let mut timed_read = |path: &Path| {
+        let start = Instant::now();
+        let image = read_image(path, size);
+        decode_seconds += start.elapsed().as_secs_f64();
+        image
+    };
+    let primary = match timed_read(&station.primary) {
+        Ok(image) => image,
+        Err(e) => {
+            return FrontEndResult {
+                station: Err(format!("station {} skipped: {e}", station.name)),
+                decode_seconds,
+                detect_seconds,
+            }
+        }
+    };
+    let mut warnings = Vec::new();
+    let right = station.right.as_ref().and_then(|path| match timed_read(path) {
+        Ok(image) => Some(image),
+        Err(e) => {
+            warnings.push(format!(
+                "station {}: right panorama unusable, no stereo cue: {e}",
+                station.name
+            ));
+            None
+        }
+    });
+    let start = Instant::now();
+    let primary_detections = detect(&primary, calib, settings);
+    let right_detections = right.as_ref().map(|r| detect(r, calib, settings));
+    detect_seconds += start.elapsed().as_secs_f64();
+    let mut files = vec![name(&station.primary)];
+    if let Some(path) = station.right.as_ref().filter(|_| right.is_some()) {
+        files.push(name(path));
+    }
+    let eye = if station.right.is_some() || is_left_image(&station.primary) {
+        PrimaryEye::Left
+    } else {
+        PrimaryEye::Mono
+    };
+    FrontEndResult {
+        station: Ok(StationDetections {
+            name: station.name.clone(),
+            files,
+            eye,
+            primary: primary_detections,
+            right: right_detections,
+            warnings,
+        }),
+        decode_seconds,
+        detect_seconds,
+    }
+}
+
+/// `NAME_left.EXT`: a left-eye panorama even when its right partner is missing.
+fn is_left_image(path: &Path) -> bool {
+    path.file_stem()
+        .is_some_and(|s| s.to_string_lossy().ends_with("_left"))
+}

@@ -1,0 +1,384 @@
+//! The mapping half of `pipeline run`: station by station, range evidence and association
+//! (000 §VI-C) turn detections into measurements, fused into the map (000 §VI-B); held-back
+//! observations are retried after every station.
+
+use super::record::{
+    Association, DetectionRecord, MetricsRecord, RangeRecord, StationRecord,
+};
+use crate::association::{associate, reconsider, AssociationSettings, Decision, Evidence, Gallery};
+use crate::calculus::{Calculus, RelationSet};
+use crate::calib::Calibration;
+use crate::detection::Detection;
+use crate::map::{Hypergraph, LandmarkId, Observation};
+use crate::measurement::{Bearing, Panorama, MAX_BEARING_UNCERTAINTY};
+use crate::neighborhood::estimate;
+use crate::ranging::{self, PrimaryEye, Ranged, SensorModel};
+use crate::simulation::observations;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// One station's detections, ready for mapping.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StationDetections {
+    pub name: String,
+    pub files: Vec<String>,
+    pub eye: PrimaryEye,
+    pub primary: Vec<Detection>,
+    /// Detections of the right panorama of a stereo station.
+    pub right: Option<Vec<Detection>>,
+    pub warnings: Vec<String>,
+}
+
+/// One landmark of `landmarks.json`: which detections it was fused from, as `(station index,
+/// detection index)` into `stations.json`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LandmarkRecord {
+    pub landmark: LandmarkId,
+    pub sightings: Vec<(usize, usize)>,
+    pub profile: crate::association::Profile,
+}
+
+/// An observation whose association stayed ambiguous, kept to be fused later.
+#[derive(Clone, Debug, PartialEq)]
+struct HeldBack {
+    station: usize,
+    panorama: Panorama,
+    /// Position in `panorama`, and index among the station's detections.
+    detection: usize,
+    primary_index: usize,
+    candidates: Vec<LandmarkId>,
+    /// The station's other detections that were fused, with their landmarks.
+    decided: Vec<(usize, LandmarkId)>,
+    evidence: Evidence,
+}
+
+/// The map being built and what association needs to remember.
+pub struct Mapper<C: Calculus> {
+    pub map: Hypergraph<C>,
+    pub gallery: Gallery,
+    calib: Calibration,
+    sensor: SensorModel,
+    association: AssociationSettings,
+    held: Vec<HeldBack>,
+    next_landmark: LandmarkId,
+    /// `(station, detection) → landmark` for every fused detection, for evaluation.
+    pub sightings: Vec<(usize, usize, LandmarkId)>,
+}
+
+impl<C: Calculus> Mapper<C> {
+    pub fn new(calib: Calibration, sensor: SensorModel, association: AssociationSettings) -> Self {
+        Mapper {
+            map: Hypergraph::new(),
+            gallery: Gallery::default(),
+            calib,
+            sensor,
+            association,
+            held: Vec::new(),
+            next_landmark: 0,
+            sightings: Vec::new(),
+        }
+    }
+
+    /// Every landmark with its looks and the station detections it was fused from.
+    pub fn landmarks(&self) -> Vec<LandmarkRecord> {
+        self.gallery
+            .profiles
+            .iter()
+            .map(|p| LandmarkRecord {
+                landmark: p.landmark,
+                sightings: self
+                    .sightings
+                    .iter()
+                    .filter(|s| s.2 == p.landmark)
+                    .map(|s| (s.0, s.1))
+                    .collect(),
+                profile: p.clone(),
+            })
+            .collect()
+    }
+
+    /// Observations still held back.
+    pub fn held_back(&self) -> usize {
+        self.held.len()
+    }
+
+    /// Maps one station; the record has everything but the decode/detect times.
+    pub fn process(&mut self, index: usize, station: &StationDetections) -> StationRecord {
+        let mut record = StationRecord {
+            index,
+            station: station.name.clone(),
+            files: station.files.clone(),
+            warnings: station.warnings.clone(),
+            ..StationRecord::default()
+        };
+        let start = Instant::now();
+        let mut ranged = ranging::observe(
+            &station.primary,
+            station.right.as_deref(),
+            station.eye,
+            &self.calib,
+            &self.sensor,
+        );
+        record.seconds.range = start.elapsed().as_secs_f64();
+        // Detections whose bearing is too uncertain to measure with are not used.
+        let usable: Vec<usize> = (0..ranged.len())
+            .filter(|&i| ranged[i].bearing.uncertainty < MAX_BEARING_UNCERTAINTY)
+            .collect();
+        record.detections = station
+            .primary
+            .iter()
+            .zip(&ranged)
+            .map(|(d, r)| detection_record(d, r))
+            .collect();
+        if usable.len() < 3 {
+            record.warnings.push(format!(
+                "{}: {} usable detections; a panorama needs at least 3 landmarks to measure",
+                station.name,
+                usable.len()
+            ));
+            record.metrics = self.metrics();
+            return record;
+        }
+
+        let start = Instant::now();
+        let panorama = panorama_of(&ranged, &usable);
+        let evidence: Vec<Evidence> = usable
+            .iter()
+            .map(|&i| Evidence {
+                appearance: station.primary[i].appearance,
+                width: ranging::width_evidence(&ranged[i], &self.sensor),
+            })
+            .collect();
+        let decisions = associate(
+            &self.map,
+            &self.gallery,
+            &panorama,
+            &evidence,
+            &self.association,
+        );
+        record.seconds.associate = start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        // Landmark ids of the detections to fuse (positions in `usable`).
+        let mut fused: Vec<(usize, LandmarkId)> = Vec::new();
+        let mut fresh = self.next_landmark;
+        let mut held = Vec::new();
+        for (k, decision) in decisions.iter().enumerate() {
+            match decision {
+                Decision::Matched(l) => fused.push((k, *l)),
+                Decision::New => {
+                    fused.push((k, fresh));
+                    fresh += 1;
+                }
+                Decision::HeldBack(candidates) => held.push((k, candidates.clone())),
+            }
+        }
+        // The size cue, for landmarks whose width earlier stations bounded.
+        for &(k, l) in &fused {
+            if let Some(width) = self.gallery.profile(l).and_then(|p| p.width) {
+                ranging::apply_size(&mut ranged[usable[k]], width, &self.sensor);
+            }
+        }
+        for (i, r) in ranged.iter().enumerate() {
+            record.detections[i].range = detection_record(&station.primary[i], r).range;
+        }
+        let panorama = panorama_of(&ranged, &usable);
+        let fused_positions: Vec<usize> = fused.iter().map(|f| f.0).collect();
+        let ids: Vec<LandmarkId> = fused.iter().map(|f| f.1).collect();
+        let sub = sub_panorama(&panorama, &fused_positions);
+        let batch = if ids.len() >= 3 {
+            observations(&self.map, &ids, &sub)
+        } else {
+            Vec::new()
+        };
+        record.fusion.landmarks = ids.len();
+        record.fusion.triples = batch.len() / 3;
+        match self.map.fuse(&batch) {
+            Ok(report) => {
+                record.fusion.relations_tightened = report.relations_tightened;
+                self.next_landmark = fresh;
+                for &(position, landmark) in &fused {
+                    let i = usable[position];
+                    self.gallery.observe(
+                        landmark,
+                        evidence[position].appearance,
+                        ranging::width_evidence(&ranged[i], &self.sensor),
+                    );
+                    self.sightings.push((index, i, landmark));
+                    record.detections[i].association = match decisions[position] {
+                        Decision::New => Association::New { landmark },
+                        _ => Association::Matched { landmark },
+                    };
+                }
+                for (k, candidates) in held {
+                    record.detections[usable[k]].association = Association::HeldBack {
+                        candidates: candidates.clone(),
+                    };
+                    self.held.push(HeldBack {
+                        station: index,
+                        panorama: panorama.clone(),
+                        detection: k,
+                        primary_index: usable[k],
+                        candidates,
+                        decided: fused.clone(),
+                        evidence: evidence[k],
+                    });
+                }
+            }
+            Err(contradiction) => {
+                record.fusion.contradiction = Some(contradiction.to_string());
+                record.warnings.push(format!(
+                    "{}: the panorama contradicts the map and was not fused ({contradiction})",
+                    station.name
+                ));
+            }
+        }
+        record.fusion.resolved_held_back = self.retry_held_back(&mut record);
+        record.seconds.map = start.elapsed().as_secs_f64();
+        record.metrics = self.metrics();
+        record
+    }
+
+    /// Tries every held-back observation against the current map; returns how many were
+    /// resolved and fused.
+    fn retry_held_back(&mut self, record: &mut StationRecord) -> usize {
+        let mut resolved = 0;
+        let mut still = Vec::new();
+        for mut item in std::mem::take(&mut self.held) {
+            let decision = reconsider(
+                &self.map,
+                &item.panorama,
+                item.detection,
+                &item.candidates,
+                &item.decided,
+                &self.association,
+            );
+            let landmark = match decision {
+                Decision::Matched(l) => l,
+                Decision::New => self.next_landmark,
+                Decision::HeldBack(candidates) => {
+                    item.candidates = candidates;
+                    still.push(item);
+                    continue;
+                }
+            };
+            let batch = focused_observations(&self.map, &item, landmark);
+            match self.map.fuse(&batch) {
+                Ok(_) => {
+                    if landmark == self.next_landmark {
+                        self.next_landmark += 1;
+                    }
+                    self.gallery
+                        .observe(landmark, item.evidence.appearance, item.evidence.width);
+                    self.sightings.push((item.station, item.primary_index, landmark));
+                    resolved += 1;
+                }
+                Err(contradiction) => record.warnings.push(format!(
+                    "held-back observation of station {} dropped: {contradiction}",
+                    item.station
+                )),
+            }
+        }
+        self.held = still;
+        resolved
+    }
+
+    /// The map's state after a station.
+    pub fn metrics(&self) -> MetricsRecord {
+        let triples = self.map.triple_count();
+        let states = 3 * triples * C::universe().len();
+        let rng = estimate(&self.map);
+        MetricsRecord {
+            landmarks: self.map.len(),
+            triples,
+            open_fraction: ratio(self.map.open_states(), states),
+            fully_constrained_fraction: ratio(self.map.fully_constrained_triples(), triples),
+            rng_certain: rng.as_ref().map_or(0, |r| r.certain().count()),
+            rng_uncertain: rng
+                .as_ref()
+                .map_or(0, |r| r.edges.len() - r.certain().count()),
+            rng_cost: rng.as_ref().map_or(0.0, |r| r.total_cost()),
+        }
+    }
+}
+
+fn ratio(a: usize, b: usize) -> f64 {
+    if b == 0 {
+        0.0
+    } else {
+        a as f64 / b as f64
+    }
+}
+
+/// The panorama of the detections at `usable` (bearings and the range order among them).
+fn panorama_of(ranged: &[Ranged], usable: &[usize]) -> Panorama {
+    let chosen: Vec<Ranged> = usable.iter().map(|&i| ranged[i]).collect();
+    let bearings: Vec<Bearing> = chosen.iter().map(|r| r.bearing).collect();
+    Panorama::new(bearings, ranging::range_order(&chosen))
+        .expect("bearings are finite, in range, with uncertainty below the limit")
+}
+
+/// The panorama restricted to `positions`.
+fn sub_panorama(panorama: &Panorama, positions: &[usize]) -> Panorama {
+    let bearings = positions.iter().map(|&p| panorama.bearings[p]).collect();
+    let pairs: Vec<(usize, usize)> = (0..positions.len())
+        .flat_map(|a| (0..positions.len()).map(move |b| (a, b)))
+        .filter(|&(a, b)| a != b && panorama.order.is_nearer(positions[a], positions[b]))
+        .collect();
+    let order = crate::measurement::RangeOrder::from_pairs(positions.len(), &pairs)
+        .expect("a restriction of a strict order is one");
+    Panorama::new(bearings, order).expect("a restriction of a valid panorama is valid")
+}
+
+/// The held-back detection's triples with the station's fused detections, as `landmark`.
+fn focused_observations<C: Calculus>(
+    map: &Hypergraph<C>,
+    item: &HeldBack,
+    landmark: LandmarkId,
+) -> Vec<Observation> {
+    let decided = &item.decided;
+    let pairs: Vec<(usize, usize)> = (0..decided.len())
+        .flat_map(|x| (x + 1..decided.len()).map(move |y| (x, y)))
+        .collect();
+    pairs
+        .par_iter()
+        .flat_map_iter(|&(x, y)| {
+            let (p, q) = (decided[x], decided[y]);
+            let ids = [landmark, p.1, q.1];
+            let open = |a, b, c| map.relation(a, b, c).unwrap_or(C::universe());
+            let states: [RelationSet; 3] = item.panorama.measure_triple::<C>(
+                [item.detection, p.0, q.0],
+                [
+                    open(ids[0], ids[1], ids[2]),
+                    open(ids[1], ids[2], ids[0]),
+                    open(ids[2], ids[0], ids[1]),
+                ],
+            );
+            [
+                Observation::new(ids[0], ids[1], ids[2], states[0]),
+                Observation::new(ids[1], ids[2], ids[0], states[1]),
+                Observation::new(ids[2], ids[0], ids[1], states[2]),
+            ]
+        })
+        .collect()
+}
+
+fn detection_record(d: &Detection, r: &Ranged) -> DetectionRecord {
+    DetectionRecord {
+        bbox: d.bbox,
+        centroid: d.centroid,
+        contact_row: d.contact_row,
+        pixels: d.pixels,
+        stereo_column: r.stereo_column,
+        bearing: r.bearing.angle,
+        bearing_uncertainty: r.bearing.uncertainty,
+        range: RangeRecord {
+            ground: r.ground.map(|g| g.as_array()),
+            stereo: r.stereo.map(|s| s.as_array()),
+            size: r.size.map(|s| s.as_array()),
+            fused: r.fused.as_array(),
+            conflict: r.conflict,
+        },
+        association: Association::Unused,
+    }
+}

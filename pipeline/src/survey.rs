@@ -1,0 +1,235 @@
+//! A directory of rover panoramas: which files make which station, and reading them.
+//!
+//! Stations are named by their files: `NAME_left.EXT` with `NAME_right.EXT` is a stereo
+//! station, any other image `NAME.EXT` a mono one (`datasets/README.md`). Stations run in
+//! natural order of their names (`station_2` before `station_10`), the order the rover took
+//! them in. Only reading happens here; what a bad file means for the run is the caller's call.
+
+use image::RgbImage;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Image extensions read as panoramas.
+const EXTENSIONS: [&str; 3] = ["png", "jpg", "jpeg"];
+
+/// One imaging point: its primary (left or mono) panorama and, for stereo, the right one.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Station {
+    pub name: String,
+    pub primary: PathBuf,
+    pub right: Option<PathBuf>,
+}
+
+/// The stations of an image directory.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Survey {
+    pub directory: PathBuf,
+    pub stations: Vec<Station>,
+    /// `NAME_right` files without a `NAME_left` partner: reported, not used.
+    pub unpaired: Vec<PathBuf>,
+}
+
+#[derive(Debug, Error)]
+pub enum SurveyError {
+    #[error("image directory {0} does not exist")]
+    Missing(PathBuf),
+    #[error("{0} is not a directory")]
+    NotDirectory(PathBuf),
+    #[error("cannot list {path}: {source}")]
+    List {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{0} holds no panoramas (.png, .jpg or .jpeg files)")]
+    Empty(PathBuf),
+}
+
+/// Why one image cannot be used.
+#[derive(Debug, Error)]
+pub enum ImageError {
+    #[error("{path}: cannot decode: {source}")]
+    Decode {
+        path: PathBuf,
+        source: image::ImageError,
+    },
+    #[error("{path}: {width}×{height} pixels, but the calibration is for {expected_width}×{expected_height}")]
+    Size {
+        path: PathBuf,
+        width: u32,
+        height: u32,
+        expected_width: u32,
+        expected_height: u32,
+    },
+}
+
+impl Survey {
+    /// Lists the stations in `directory`.
+    pub fn open(directory: &Path) -> Result<Survey, SurveyError> {
+        if !directory.exists() {
+            return Err(SurveyError::Missing(directory.to_path_buf()));
+        }
+        if !directory.is_dir() {
+            return Err(SurveyError::NotDirectory(directory.to_path_buf()));
+        }
+        let list_error = |source| SurveyError::List {
+            path: directory.to_path_buf(),
+            source,
+        };
+        let mut images = Vec::new();
+        for entry in std::fs::read_dir(directory).map_err(list_error)? {
+            let path = entry.map_err(list_error)?.path();
+            let is_image = path
+                .extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()));
+            if is_image && path.is_file() {
+                images.push(path);
+            }
+        }
+        let survey = Survey::from_files(directory, images);
+        if survey.stations.is_empty() {
+            return Err(SurveyError::Empty(directory.to_path_buf()));
+        }
+        Ok(survey)
+    }
+
+    /// Groups image paths into stations (pure: no file system access).
+    pub fn from_files(directory: &Path, mut images: Vec<PathBuf>) -> Survey {
+        images.sort_by(|a, b| natural_order(&stem(a), &stem(b)));
+        let mut stations = Vec::new();
+        let mut unpaired = Vec::new();
+        for path in &images {
+            let name = stem(path);
+            if let Some(base) = name.strip_suffix("_right") {
+                let has_left = images.iter().any(|p| stem(p) == format!("{base}_left"));
+                if !has_left {
+                    unpaired.push(path.clone());
+                }
+                continue;
+            }
+            let (station, right) = match name.strip_suffix("_left") {
+                Some(base) => {
+                    let right = images
+                        .iter()
+                        .find(|p| stem(p) == format!("{base}_right"))
+                        .cloned();
+                    (base.to_string(), right)
+                }
+                None => (name.clone(), None),
+            };
+            stations.push(Station {
+                name: station,
+                primary: path.clone(),
+                right,
+            });
+        }
+        Survey {
+            directory: directory.to_path_buf(),
+            stations,
+            unpaired,
+        }
+    }
+}
+
+/// Reads one panorama as 8-bit RGB and checks its size against the calibration's.
+pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageError> {
+    let image = image::ImageReader::open(path)
+        .map_err(|e| ImageError::Decode {
+            path: path.to_path_buf(),
+            source: image::ImageError::IoError(e),
+        })?
+        .with_guessed_format()
+        .map_err(|e| ImageError::Decode {
+            path: path.to_path_buf(),
+            source: image::ImageError::IoError(e),
+        })?
+        .decode()
+        .map_err(|source| ImageError::Decode {
+            path: path.to_path_buf(),
+            source,
+        })?
+        .into_rgb8();
+    if image.dimensions() != expected {
+        return Err(ImageError::Size {
+            path: path.to_path_buf(),
+            width: image.width(),
+            height: image.height(),
+            expected_width: expected.0,
+            expected_height: expected.1,
+        });
+    }
+    Ok(image)
+}
+
+fn stem(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Compares names with digit runs as numbers, so that `s_9` sorts before `s_10`.
+fn natural_order(a: &str, b: &str) -> std::cmp::Ordering {
+    fn chunks(s: &str) -> Vec<(bool, &str)> {
+        let mut out = Vec::new();
+        let mut start = 0;
+        let bytes = s.as_bytes();
+        for i in 1..=bytes.len() {
+            if i == bytes.len() || bytes[i].is_ascii_digit() != bytes[start].is_ascii_digit() {
+                out.push((bytes[start].is_ascii_digit(), &s[start..i]));
+                start = i;
+            }
+        }
+        out
+    }
+    let (ca, cb) = (chunks(a), chunks(b));
+    for (x, y) in ca.iter().zip(&cb) {
+        let ordering = match (x, y) {
+            ((true, p), (true, q)) => {
+                let (p, q) = (p.trim_start_matches('0'), q.trim_start_matches('0'));
+                p.len().cmp(&q.len()).then_with(|| p.cmp(q))
+            }
+            ((_, p), (_, q)) => p.cmp(q),
+        };
+        if ordering.is_ne() {
+            return ordering;
+        }
+    }
+    ca.len().cmp(&cb.len()).then_with(|| a.cmp(b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paths(names: &[&str]) -> Vec<PathBuf> {
+        names.iter().map(|n| PathBuf::from("d").join(n)).collect()
+    }
+
+    #[test]
+    fn pairs_stereo_and_keeps_mono_in_natural_order() {
+        let survey = Survey::from_files(
+            Path::new("d"),
+            paths(&[
+                "s_10_left.png",
+                "s_10_right.png",
+                "s_9_right.png",
+                "s_9_left.png",
+                "mono_2.jpg",
+                "lonely_right.png",
+            ]),
+        );
+        let names: Vec<_> = survey.stations.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["mono_2", "s_9", "s_10"]);
+        assert_eq!(survey.stations[1].right, Some(PathBuf::from("d/s_9_right.png")));
+        assert_eq!(survey.stations[0].right, None);
+        assert_eq!(survey.unpaired, vec![PathBuf::from("d/lonely_right.png")]);
+    }
+
+    #[test]
+    fn natural_order_compares_numbers() {
+        assert!(natural_order("station_2", "station_10").is_lt());
+        assert!(natural_order("station_002", "station_010").is_lt());
+        assert!(natural_order("a", "b").is_lt());
+        assert!(natural_order("a1", "a1b").is_lt());
+    }
+}
