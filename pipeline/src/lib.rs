@@ -6,6 +6,7 @@ pub mod atomic_file;
 pub mod calculus;
 pub mod calib;
 pub mod dataset;
+pub mod detection;
 pub mod edc;
 pub mod fdc;
 pub mod feasibility;
