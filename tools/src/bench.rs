@@ -49,6 +49,72 @@ struct Args {
     /// With `--render`: also save the left image of the first pair, shrunk 4×, as this PNG.
     #[arg(long, value_name = "PNG")]
     preview: Option<std::path::PathBuf>,
+    /// Time the rock detector on a dataset directory (calib.toml, PNGs, optional truth.json);
+    /// with truth, also prints precision, recall, bearing and contact errors.
+    #[arg(long, value_name = "DIR")]
+    detect: Option<std::path::PathBuf>,
+}
+
+/// Decodes every image of a dataset, detects rocks in each (single thread), and prints the
+/// decode and detection time per image and, with `truth.json`, the detector's score.
+fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
+    use qrm::detection::{detect, median_and_max, DetectorSettings, Score};
+    let calib = qrm::calib::Calibration::load(&dir.join("calib.toml"))?;
+    let truth: Option<qrm::dataset::Truth> = match std::fs::read_to_string(dir.join("truth.json")) {
+        Ok(text) => Some(serde_json::from_str(&text)?),
+        Err(_) => None,
+    };
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(dir)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "png"))
+        .collect();
+    files.sort();
+    let settings = DetectorSettings::default();
+    let (mut decode, mut detecting) = (0.0, Vec::new());
+    let mut score = Score::default();
+    for file in &files {
+        let start = Instant::now();
+        let image = image::open(file)?.into_rgb8();
+        decode += start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let found = detect(&image, &calib, &settings);
+        detecting.push(start.elapsed().as_secs_f64());
+        let name = file
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or_default();
+        if let Some(t) = truth
+            .as_ref()
+            .and_then(|t| t.images.iter().find(|i| i.file == name))
+        {
+            score.add(&found, &t.rocks, &calib, &settings);
+        }
+    }
+    let n = files.len().max(1) as f64;
+    detecting.sort_by(f64::total_cmp);
+    println!(
+        "detect: {} images {}x{}: decode {:.1} ms/image, detect mean {:.1} ms, median {:.1} ms, max {:.1} ms",
+        files.len(),
+        calib.image.width,
+        calib.image.height,
+        1e3 * decode / n,
+        1e3 * detecting.iter().sum::<f64>() / n,
+        1e3 * detecting.get(detecting.len() / 2).copied().unwrap_or(0.0),
+        1e3 * detecting.last().copied().unwrap_or(0.0),
+    );
+    if truth.is_some() {
+        let (bearing_median, bearing_max) = median_and_max(&score.bearing_errors);
+        let (contact_median, contact_max) = median_and_max(&score.contact_errors);
+        println!(
+            "detect: {} detectable, {} found, {} false, {} splits, {} merged: precision {:.3}, recall {:.3}",
+            score.detectable, score.found, score.false_alarms, score.splits, score.merged,
+            score.precision(), score.recall()
+        );
+        println!(
+            "detect: bearing error median {bearing_median:.2} px, max {bearing_max:.2} px; contact row error median {contact_median:.2} px, max {contact_max:.2} px"
+        );
+    }
+    Ok(())
 }
 
 /// Renders stereo pairs of 30 random rocks in a 20 m square with the default calibration:
@@ -264,6 +330,13 @@ fn time_decisions(problems: &[(Vec<f64>, Vec<f64>, Vec<Quadratic>)]) -> (f64, f6
 
 fn main() {
     let args = Args::parse();
+    if let Some(dir) = &args.detect {
+        if let Err(e) = bench_detect(dir) {
+            eprintln!("qrm-bench: {e:#}");
+            std::process::exit(1);
+        }
+        return;
+    }
     if args.render {
         bench_render(args.preview.as_deref());
         return;

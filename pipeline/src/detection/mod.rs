@@ -1,0 +1,241 @@
+//! Rock detection in one panorama: which blobs below the horizon are rocks, where they touch the
+//! ground (for flat-ground range) and where their centre lies (for bearing), plus an appearance
+//! signature for telling the same rock apart in panoramas taken a few metres apart.
+//!
+//! The ground's brightness and colour depend mainly on the row (haze grows with range), so the
+//! background is modelled per row by medians, which rocks (a small fraction of any row) do not
+//! move. Rock pixels differ from regolith in chroma (rocks are greyer than the red soil), or are
+//! much brighter; cast shadows are darker but keep the regolith's red hue, so they are left out
+//! and cannot drag the contact row or centroid. Small blobs are rejected by physical width at
+//! the flat-ground range of their contact row, which removes pebbles at every resolution.
+
+mod components;
+mod score;
+
+use crate::calib::Calibration;
+use components::{label_wrapped, Blob};
+use imageproc::distance_transform::Norm;
+use imageproc::morphology::close_mut;
+use kornia_image::{Image, ImageSize};
+pub use score::{detectable, median_and_max, Score};
+use serde::{Deserialize, Serialize};
+
+/// Thresholds of the detector. Ratios are relative to the row's median regolith.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DetectorSettings {
+    /// Narrowest rock kept, metres of visible width at the contact range (pebbles are ≤ 8 cm).
+    pub min_width_m: f64,
+    /// Farthest rock kept, metres of flat-ground range at the contact row.
+    pub max_range_m: f64,
+    /// A pixel whose `(r − b)/(r + g + b)` is this much below its row's median is rock: rocks
+    /// are greyer than the red regolith, in sun and in shade alike.
+    pub chroma_drop: f32,
+    /// A pixel this many times brighter than its row's median is rock (shadows never are).
+    pub bright_ratio: f32,
+    /// A pixel darker than this fraction of its row's median is rock if it is also greyer by
+    /// `dark_chroma_drop`: the shaded side of a rock, told from cast shadows (which stay red).
+    pub dark_ratio: f32,
+    pub dark_chroma_drop: f32,
+}
+
+impl Default for DetectorSettings {
+    fn default() -> Self {
+        DetectorSettings {
+            min_width_m: 0.12,
+            max_range_m: 30.0,
+            chroma_drop: 0.035,
+            bright_ratio: 1.25,
+            dark_ratio: 0.6,
+            dark_chroma_drop: 0.02,
+        }
+    }
+}
+
+/// One rock-like blob in one panorama.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Detection {
+    /// Mean continuous (column, row) of the rock pixels, pixel centres at `+0.5`; the column in
+    /// `[0, width)`.
+    pub centroid: [f64; 2],
+    /// `[col_min, row_min, col_max, row_max]`, inclusive; `col_max ≥ width` when the blob
+    /// straddles the seam.
+    pub bbox: [u32; 4],
+    /// Rock pixels (shadow excluded).
+    pub pixels: u32,
+    /// Continuous row of the bottom edge of the rock itself (its ground contact).
+    pub contact_row: f64,
+    pub appearance: Appearance,
+}
+
+/// Statistics that change little with viewpoint, for associating a rock across panoramas.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Appearance {
+    /// Mean chromaticity (r, g, b summing to 1).
+    pub colour: [f32; 3],
+    /// Rock luminance over the regolith's median luminance at the same rows.
+    pub brightness: f32,
+    /// Luminance standard deviation over mean, inside the rock.
+    pub texture: f32,
+    /// Fraction of the rock's pixels darker than `dark_ratio` of the regolith: its shaded side.
+    pub dark_fraction: f32,
+}
+
+/// Detects rocks in `image`, sorted by centroid column. An image whose size differs from the
+/// calibration's yields no detections (its geometry would be meaningless).
+pub fn detect(
+    image: &image::RgbImage,
+    calib: &Calibration,
+    settings: &DetectorSettings,
+) -> Vec<Detection> {
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    if image.width() != calib.image.width || image.height() != calib.image.height || w == 0 {
+        return Vec::new();
+    }
+    let top = (calib.elevation.horizon_row.floor().max(0.0) as usize).min(h);
+    let rows = h - top;
+    if rows == 0 {
+        return Vec::new();
+    }
+    let raw = &image.as_raw()[top * w * 3..];
+    let background = row_medians(raw, w);
+    let mut mask = segment(raw, &background, w, settings);
+    close_mut(&mut mask, Norm::LInf, 1);
+    let Ok(mask) = Image::<u8, 1>::new(
+        ImageSize {
+            width: w,
+            height: rows,
+        },
+        mask.into_raw(),
+    ) else {
+        return Vec::new();
+    };
+    let blobs = label_wrapped(&mask, w, rows, |i| {
+        let p = &raw[3 * i..3 * i + 3];
+        let sum = f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2]);
+        let ratio = sum / background[i / w].0.max(1.0);
+        PixelSample {
+            rgb: [f32::from(p[0]), f32::from(p[1]), f32::from(p[2])],
+            ratio,
+            dark: ratio < settings.dark_ratio,
+        }
+    });
+    let mut detections: Vec<Detection> = blobs
+        .into_iter()
+        .filter_map(|b| accept(b, top, calib, settings))
+        .collect();
+    detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
+    detections
+}
+
+/// What a blob accumulates of each of its pixels for its appearance.
+struct PixelSample {
+    rgb: [f32; 3],
+    /// Luminance over the row's median.
+    ratio: f32,
+    /// Darker than `dark_ratio` of the row's median.
+    dark: bool,
+}
+
+/// Luminance `r + g + b` and redness `(r − b)/(r + g + b)` of a pixel.
+fn luminance_redness(p: &[u8]) -> (f32, f32) {
+    let s = f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2]);
+    (s, (f32::from(p[0]) - f32::from(p[2])) / (s + 1.0))
+}
+
+/// Median luminance and redness of each row, from every fourth column at most (rocks cover a
+/// small part of any row; the sample keeps the medians cheap).
+fn row_medians(raw: &[u8], w: usize) -> Vec<(f32, f32)> {
+    let step = if w >= 1024 { 4 } else { 1 };
+    let mut sums = Vec::with_capacity(w / step + 1);
+    let mut reds = Vec::with_capacity(w / step + 1);
+    raw.chunks_exact(3 * w)
+        .map(|row| {
+            sums.clear();
+            reds.clear();
+            for p in row.chunks_exact(3).step_by(step) {
+                let (s, r) = luminance_redness(p);
+                sums.push(s);
+                reds.push(r);
+            }
+            let mid = sums.len() / 2;
+            (
+                *sums.select_nth_unstable_by(mid, f32::total_cmp).1,
+                *reds.select_nth_unstable_by(mid, f32::total_cmp).1,
+            )
+        })
+        .collect()
+}
+
+/// Rock pixels (255) of the ground band, tested without divisions: `ratio > k` as
+/// `sum > k · median`, a redness drop as `(median − t)(sum + 1) > r − b`.
+fn segment(
+    raw: &[u8],
+    background: &[(f32, f32)],
+    w: usize,
+    s: &DetectorSettings,
+) -> image::GrayImage {
+    let rows = background.len();
+    let mut mask = vec![0u8; w * rows];
+    for ((row, out), &(bg_sum, bg_red)) in raw
+        .chunks_exact(3 * w)
+        .zip(mask.chunks_exact_mut(w))
+        .zip(background)
+    {
+        let bright = s.bright_ratio * bg_sum;
+        let dark = s.dark_ratio * bg_sum;
+        let grey = bg_red - s.chroma_drop;
+        let dark_grey = bg_red - s.dark_chroma_drop;
+        for (p, m) in row.chunks_exact(3).zip(out.iter_mut()) {
+            let sum = f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2]);
+            let red = f32::from(p[0]) - f32::from(p[2]);
+            let scale = sum + 1.0;
+            let rock =
+                red < grey * scale || sum > bright || (sum < dark && red < dark_grey * scale);
+            *m = if rock { 255 } else { 0 };
+        }
+    }
+    image::GrayImage::from_raw(w as u32, rows as u32, mask).unwrap_or_default()
+}
+
+/// The detection of `blob` (band rows offset by `top`), or `None` if it is narrower than
+/// `min_width_m` or farther than `max_range_m`.
+fn accept(
+    blob: Blob,
+    top: usize,
+    calib: &Calibration,
+    settings: &DetectorSettings,
+) -> Option<Detection> {
+    let n = f64::from(blob.pixels);
+    let contact_row = (blob.row_max + top + 1) as f64;
+    let range = calib.ground_range(contact_row)?;
+    let width_px = (blob.col_max - blob.col_min + 1) as f64;
+    if range > settings.max_range_m
+        || width_px * calib.column_width() * range < settings.min_width_m
+    {
+        return None;
+    }
+    let width = f64::from(calib.image.width);
+    let mean_luminance = blob.sum_luminance / n;
+    let variance = (blob.sum_luminance_sq / n - mean_luminance * mean_luminance).max(0.0);
+    let total: f64 = blob.sum_rgb.iter().sum::<f64>().max(1.0);
+    Some(Detection {
+        centroid: [
+            (blob.sum_col / n).rem_euclid(width),
+            blob.sum_row / n + top as f64,
+        ],
+        bbox: [
+            blob.col_min as u32,
+            (blob.row_min + top) as u32,
+            blob.col_max as u32,
+            (blob.row_max + top) as u32,
+        ],
+        pixels: blob.pixels,
+        contact_row,
+        appearance: Appearance {
+            colour: blob.sum_rgb.map(|c| (c / total) as f32),
+            brightness: (blob.sum_ratio / n) as f32,
+            texture: (variance.sqrt() / mean_luminance.max(1.0)) as f32,
+            dark_fraction: (f64::from(blob.dark) / n) as f32,
+        },
+    })
+}

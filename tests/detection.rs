@@ -1,0 +1,139 @@
+//! The rock detector against the renderer's per-pixel rock ids: full-resolution stations of
+//! both presets, the low-resolution demo set, and images it must survive. Thresholds are the
+//! measured figures less a margin (`qrm-bench --detect DIR` gives full-set numbers);
+//! merges of rocks that overlap in the image are the main loss in the clustered Mars Yard.
+
+use qrm::calib::Calibration;
+use qrm::dataset::{visible_rocks, Counts, Preset, Truth};
+use qrm::detection::{detect, median_and_max, DetectorSettings, Score};
+use qrm::synth::{render, Eye, World};
+
+fn calibration() -> Calibration {
+    Calibration::parse(include_str!("../calib/default.toml"), "default.toml").unwrap()
+}
+
+fn score_stations(preset: Preset, stations: &[usize]) -> Score {
+    let calib = calibration();
+    let layout = preset.layout(7, Counts::default());
+    let world = World::generate(7, &layout.rocks);
+    let settings = DetectorSettings::default();
+    let mut score = Score::default();
+    for &k in stations {
+        let pose = layout.stations[k];
+        let r = render(&world, &calib, pose, Eye::Left);
+        let truth = visible_rocks(&world, &calib, pose, Eye::Left, &r);
+        let image = image::RgbImage::from_raw(r.width, r.height, r.rgb).unwrap();
+        score.add(
+            &detect(&image, &calib, &settings),
+            &truth,
+            &calib,
+            &settings,
+        );
+    }
+    score
+}
+
+fn check(score: &Score, precision: f64, recall: f64) {
+    let (bearing, _) = median_and_max(&score.bearing_errors);
+    let (contact, _) = median_and_max(&score.contact_errors);
+    println!(
+        "{} detectable, {} found, {} false, {} splits, {} merged: precision {:.3} recall {:.3} bearing median {bearing:.2} px contact median {contact:.2} px",
+        score.detectable, score.found, score.false_alarms, score.splits, score.merged,
+        score.precision(),
+        score.recall()
+    );
+    assert!(score.detectable >= 20, "{}", score.detectable);
+    assert!(
+        score.precision() >= precision,
+        "precision {}",
+        score.precision()
+    );
+    assert!(score.recall() >= recall, "recall {}", score.recall());
+    assert!(bearing <= 1.5, "bearing median {bearing}");
+    assert!(contact <= 1.5, "contact median {contact}");
+}
+
+#[test]
+fn random_full_resolution() {
+    check(&score_stations(Preset::Random, &[0, 9, 23]), 0.8, 0.85);
+}
+
+#[test]
+fn marsyard_full_resolution() {
+    check(&score_stations(Preset::Marsyard, &[0, 17, 33]), 0.75, 0.65);
+}
+
+/// The demo set at 1024 × 192: a quarter of the resolution, so the same settings see fewer
+/// pixels per rock; rocks merge more, but what is found is placed as well.
+#[test]
+fn demo_set_low_resolution() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../datasets/demo");
+    let calib = Calibration::load(&std::path::Path::new(dir).join("calib.toml")).unwrap();
+    let truth: Truth =
+        serde_json::from_str(&std::fs::read_to_string(format!("{dir}/truth.json")).unwrap())
+            .unwrap();
+    let settings = DetectorSettings::default();
+    let mut score = Score::default();
+    for t in truth.images.iter().step_by(4) {
+        let image = image::open(format!("{dir}/{}", t.file))
+            .unwrap()
+            .into_rgb8();
+        score.add(
+            &detect(&image, &calib, &settings),
+            &t.rocks,
+            &calib,
+            &settings,
+        );
+    }
+    check(&score, 0.9, 0.55);
+}
+
+/// A blank panorama, one of the wrong size and a black one give no detections and no panic.
+#[test]
+fn degenerate_images_give_nothing() {
+    let calib = calibration();
+    let settings = DetectorSettings::default();
+    let black = image::RgbImage::new(calib.image.width, calib.image.height);
+    assert!(detect(&black, &calib, &settings).is_empty());
+    let tiny = image::RgbImage::new(3, 2);
+    assert!(detect(&tiny, &calib, &settings).is_empty());
+    let flat = image::RgbImage::from_pixel(
+        calib.image.width,
+        calib.image.height,
+        image::Rgb([180, 110, 70]),
+    );
+    assert!(detect(&flat, &calib, &settings).is_empty());
+}
+
+/// A grey rock painted across the seam, with a red-hued shadow below it and a pebble-sized
+/// grey dot: one detection, wrapping, its contact at the rock's bottom edge, no pebble.
+#[test]
+fn seam_rock_shadow_and_pebble() {
+    let calib = calibration();
+    let (w, h) = (calib.image.width, calib.image.height);
+    let mut image = image::RgbImage::from_pixel(w, h, image::Rgb([180, 110, 70]));
+    let grey = image::Rgb([120, 110, 100]);
+    let shadow = image::Rgb([100, 55, 30]);
+    for row in 400..440 {
+        for col in (w - 20..w).chain(0..25) {
+            image.put_pixel(col, row, grey);
+        }
+    }
+    for row in 440..450 {
+        for col in (w - 10..w).chain(0..40) {
+            image.put_pixel(col, row, shadow);
+        }
+    }
+    for row in 500..503 {
+        for col in 1000..1003 {
+            image.put_pixel(col, row, grey);
+        }
+    }
+    let found = detect(&image, &calib, &DetectorSettings::default());
+    assert_eq!(found.len(), 1, "{found:?}");
+    let d = &found[0];
+    assert_eq!(d.bbox, [w - 20, 400, w + 24, 439]);
+    assert_eq!(d.contact_row, 440.0);
+    assert!((d.centroid[0] - 2.5).abs() < 1e-9, "{:?}", d.centroid);
+    assert!(d.appearance.colour[0] < 0.4);
+}
