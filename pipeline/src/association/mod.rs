@@ -3,7 +3,10 @@
 //! Appearance proposes, the qualitative map decides:
 //! 1. the [`Gallery`] proposes, for each detection, the landmarks whose descriptor and
 //!    physical width are close enough;
-//! 2. **anchors** are mutual, clearly-best proposals; they are checked against each other: a
+//! 2. **anchors** are the unambiguous correspondences of the rigid motion that best lines up
+//!    the station's look-alike detections with a recent station's landmarks ([`register`]);
+//!    the motion also rules out the frame's landmarks that lie away from a detection. Anchors
+//!    are checked against each other: a
 //!    triple of anchors whose measured states do not overlap the map's is inconsistent, and
 //!    the anchor in most such triples is dropped until none is left;
 //! 3. every other proposal is tested as 000 §VI-C describes: the detection's triples with
@@ -14,8 +17,10 @@
 //!    tighter. Nothing is fused on a guess.
 
 mod gallery;
+mod registration;
 
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
+pub use registration::{register, Frame, Placed, Registration, MIN_INLIERS};
 
 use crate::calculus::Calculus;
 use crate::detection::Appearance;
@@ -24,14 +29,16 @@ use crate::measurement::Panorama;
 use crate::ranging::RangeInterval;
 use serde::{Deserialize, Serialize};
 
+/// Slack of the placement test against a registered frame, metres: generous, since ruling
+/// out the true landmark would make a duplicate.
+const PLACEMENT_SLACK_M: f64 = 1.0;
+
 /// Thresholds of association.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AssociationSettings {
     pub scales: AppearanceScales,
     /// Largest descriptor distance of a candidate.
     pub gate: f64,
-    /// An anchor's distance must be below this fraction of the runner-up's.
-    pub ratio: f64,
     /// Triples a single surviving candidate must have been tested on, with relations the map
     /// constrains, before it is taken without appearance backing.
     pub informative_triples: usize,
@@ -44,7 +51,6 @@ impl Default for AssociationSettings {
         AssociationSettings {
             scales: AppearanceScales::default(),
             gate: 4.0,
-            ratio: 0.6,
             informative_triples: 6,
             tested_pairs: 40,
         }
@@ -52,7 +58,7 @@ impl Default for AssociationSettings {
 }
 
 /// What one detection needs for association.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Evidence {
     pub appearance: Appearance,
     /// Physical width bounds from this station's range evidence.
@@ -68,12 +74,15 @@ pub enum Decision {
 }
 
 /// Associates the detections of one station (`panorama` holds their bearings and range order,
-/// `evidence` their looks, both indexed alike).
+/// `evidence` their looks and `placed` their rough positions around the station, all indexed
+/// alike; `frames` are recent stations' landmarks placed the same way).
 pub fn associate<C: Calculus>(
     map: &Hypergraph<C>,
     gallery: &Gallery,
     panorama: &Panorama,
     evidence: &[Evidence],
+    placed: &[Option<Placed>],
+    frames: &[Frame],
     settings: &AssociationSettings,
 ) -> Vec<Decision> {
     let n = evidence.len();
@@ -84,7 +93,52 @@ pub fn associate<C: Calculus>(
         .iter()
         .map(|e| proposals(e, gallery, settings))
         .collect();
-    let mut anchors = anchor_proposals(&candidates, settings);
+    let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
+    let registrations: Vec<(&Frame, Registration)> = frames
+        .iter()
+        .filter_map(|frame| Some((frame, register(placed, frame, &alike)?)))
+        .collect();
+    // Registered correspondences of all frames; a detection or landmark given two different
+    // partners by different frames is left out.
+    let mut pairs: Vec<(usize, LandmarkId)> = registrations
+        .iter()
+        .flat_map(|(_, r)| r.pairs.iter().copied())
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    let conflicted = |&(i, l): &(usize, LandmarkId)| {
+        pairs.iter().any(|&(j, m)| (j == i) != (m == l))
+    };
+    let mut anchors: Vec<(usize, LandmarkId, f64)> = pairs
+        .iter()
+        .filter(|p| !conflicted(p))
+        .map(|&(i, l)| {
+            let d = candidates[i].iter().find(|c| c.0 == l).map_or(0.0, |c| c.1);
+            (i, l, d)
+        })
+        .collect();
+    // A registered frame also rules out, for each detection, the frame's landmarks that lie
+    // away from where the motion puts it.
+    let candidates: Vec<Vec<(LandmarkId, f64)>> = candidates
+        .into_iter()
+        .enumerate()
+        .map(|(i, list)| {
+            list.into_iter()
+                .filter(|&(l, _)| {
+                    registrations.iter().all(|(frame, r)| {
+                        match (placed[i], frame.landmarks.iter().find(|f| f.0 == l)) {
+                            (Some(p), Some((_, q))) => {
+                                let t = r.to_frame(p.point);
+                                (t[0] - q.point[0]).hypot(t[1] - q.point[1])
+                                    <= p.radius + q.radius + PLACEMENT_SLACK_M
+                            }
+                            _ => true,
+                        }
+                    })
+                })
+                .collect()
+        })
+        .collect();
     drop_inconsistent_anchors(map, panorama, &mut anchors);
     let anchored: Vec<(usize, LandmarkId)> = anchors.iter().map(|a| (a.0, a.1)).collect();
 
@@ -150,33 +204,6 @@ fn proposals(
         .collect();
     out.sort_by(|a, b| a.1.total_cmp(&b.1));
     out
-}
-
-/// Mutual best proposals that clearly beat the runner-up on both sides: `(detection,
-/// landmark, distance)`.
-fn anchor_proposals(
-    candidates: &[Vec<(LandmarkId, f64)>],
-    settings: &AssociationSettings,
-) -> Vec<(usize, LandmarkId, f64)> {
-    let clear = |best: f64, second: Option<f64>| second.is_none_or(|s| best < settings.ratio * s);
-    candidates
-        .iter()
-        .enumerate()
-        .filter_map(|(i, list)| {
-            let &(landmark, d) = list.first()?;
-            if !clear(d, list.get(1).map(|c| c.1)) {
-                return None;
-            }
-            // The landmark's other claimants must be clearly worse.
-            let rival = candidates
-                .iter()
-                .enumerate()
-                .filter(|&(j, _)| j != i)
-                .filter_map(|(_, l)| l.iter().find(|c| c.0 == landmark).map(|c| c.1))
-                .min_by(f64::total_cmp);
-            clear(d, rival).then_some((i, landmark, d))
-        })
-        .collect()
 }
 
 /// Whether the measured states of detections `[a, b, c]` overlap the map's relations of

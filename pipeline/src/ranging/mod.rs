@@ -190,8 +190,8 @@ fn fuse(cues: [Option<RangeInterval>; 3]) -> (RangeInterval, bool) {
 }
 
 /// Flat-ground cue (000 §IV: flat ground, mast height known). `None` if the contact is at or
-/// above the horizon, or may be hidden behind a nearer detection (then the visible bottom is
-/// not the contact).
+/// above the horizon, below the image, or may be hidden behind a nearer detection (then the
+/// visible bottom is not the contact).
 fn ground_cue(
     d: &Detection,
     index: usize,
@@ -201,7 +201,8 @@ fn ground_cue(
     angular_width: f64,
     half_baseline: f64,
 ) -> Option<RangeInterval> {
-    if contact_hidden(index, all, calib.image.width) {
+    // Cut off by the bottom edge: the contact is not in the picture.
+    if d.bbox[3] + 1 >= calib.image.height || contact_hidden(index, all, calib.image.width) {
         return None;
     }
     let near = calib.ground_range(d.contact_row + model.contact_error_px)?;

@@ -5,7 +5,9 @@
 use super::record::{
     Association, DetectionRecord, MetricsRecord, RangeRecord, StationRecord,
 };
-use crate::association::{associate, reconsider, AssociationSettings, Decision, Evidence, Gallery};
+use crate::association::{
+    associate, reconsider, AssociationSettings, Decision, Evidence, Frame, Gallery, Placed,
+};
 use crate::calculus::{Calculus, RelationSet};
 use crate::calib::Calibration;
 use crate::detection::Detection;
@@ -60,6 +62,10 @@ pub struct Mapper<C: Calculus> {
     sensor: SensorModel,
     association: AssociationSettings,
     held: Vec<HeldBack>,
+    /// The most recent stations' fused landmarks, placed around each station.
+    frames: Vec<Frame>,
+    /// Held-back observations given up after [`HOLD_STATIONS`].
+    pub expired: usize,
     next_landmark: LandmarkId,
     /// `(station, detection) → landmark` for every fused detection, for evaluation.
     pub sightings: Vec<(usize, usize, LandmarkId)>,
@@ -74,6 +80,8 @@ impl<C: Calculus> Mapper<C> {
             sensor,
             association,
             held: Vec::new(),
+            frames: Vec::new(),
+            expired: 0,
             next_landmark: 0,
             sightings: Vec::new(),
         }
@@ -145,15 +153,18 @@ impl<C: Calculus> Mapper<C> {
         let evidence: Vec<Evidence> = usable
             .iter()
             .map(|&i| Evidence {
-                appearance: station.primary[i].appearance,
+                appearance: station.primary[i].appearance.clone(),
                 width: ranging::width_evidence(&ranged[i], &self.sensor),
             })
             .collect();
+        let placed: Vec<Option<Placed>> = usable.iter().map(|&i| placed(&ranged[i])).collect();
         let decisions = associate(
             &self.map,
             &self.gallery,
             &panorama,
             &evidence,
+            &placed,
+            &self.frames,
             &self.association,
         );
         record.seconds.associate = start.elapsed().as_secs_f64();
@@ -183,6 +194,11 @@ impl<C: Calculus> Mapper<C> {
             record.detections[i].range = detection_record(&station.primary[i], r).range;
         }
         let panorama = panorama_of(&ranged, &usable);
+        record.order = (0..usable.len())
+            .flat_map(|a| (0..usable.len()).map(move |b| (a, b)))
+            .filter(|&(a, b)| panorama.order.is_nearer(a, b))
+            .map(|(a, b)| (usable[a], usable[b]))
+            .collect();
         let fused_positions: Vec<usize> = fused.iter().map(|f| f.0).collect();
         let ids: Vec<LandmarkId> = fused.iter().map(|f| f.1).collect();
         let sub = sub_panorama(&panorama, &fused_positions);
@@ -201,7 +217,7 @@ impl<C: Calculus> Mapper<C> {
                     let i = usable[position];
                     self.gallery.observe(
                         landmark,
-                        evidence[position].appearance,
+                        evidence[position].appearance.clone(),
                         ranging::width_evidence(&ranged[i], &self.sensor),
                     );
                     self.sightings.push((index, i, landmark));
@@ -209,6 +225,16 @@ impl<C: Calculus> Mapper<C> {
                         Decision::New => Association::New { landmark },
                         _ => Association::Matched { landmark },
                     };
+                }
+                let frame = Frame {
+                    landmarks: fused
+                        .iter()
+                        .filter_map(|&(position, landmark)| Some((landmark, placed[position]?)))
+                        .collect(),
+                };
+                self.frames.push(frame);
+                if self.frames.len() > RECENT_FRAMES {
+                    self.frames.remove(0);
                 }
                 for (k, candidates) in held {
                     record.detections[usable[k]].association = Association::HeldBack {
@@ -221,7 +247,7 @@ impl<C: Calculus> Mapper<C> {
                         primary_index: usable[k],
                         candidates,
                         decided: fused.clone(),
-                        evidence: evidence[k],
+                        evidence: evidence[k].clone(),
                     });
                 }
             }
@@ -244,7 +270,12 @@ impl<C: Calculus> Mapper<C> {
     fn retry_held_back(&mut self, record: &mut StationRecord) -> usize {
         let mut resolved = 0;
         let mut still = Vec::new();
+        let current = record.index;
         for mut item in std::mem::take(&mut self.held) {
+            if current > item.station + HOLD_STATIONS {
+                self.expired += 1;
+                continue;
+            }
             let decision = reconsider(
                 &self.map,
                 &item.panorama,
@@ -269,7 +300,7 @@ impl<C: Calculus> Mapper<C> {
                         self.next_landmark += 1;
                     }
                     self.gallery
-                        .observe(landmark, item.evidence.appearance, item.evidence.width);
+                        .observe(landmark, item.evidence.appearance.clone(), item.evidence.width);
                     self.sightings.push((item.station, item.primary_index, landmark));
                     resolved += 1;
                 }
@@ -300,6 +331,25 @@ impl<C: Calculus> Mapper<C> {
             rng_cost: rng.as_ref().map_or(0.0, |r| r.total_cost()),
         }
     }
+}
+
+/// Recent stations registered against (a rover moves a few metres between stations: the most
+/// recent ones share most landmarks with the current one).
+const RECENT_FRAMES: usize = 6;
+
+/// Stations a held-back observation waits for the map to tighten before it is given up (an
+/// observation not fused loses information, never soundness).
+const HOLD_STATIONS: usize = 3;
+
+/// A detection's rough position around the station, if its range is bounded well enough to
+/// place it: the middle of its range interval along its bearing.
+fn placed(r: &Ranged) -> Option<Placed> {
+    let [low, high] = r.fused.as_array();
+    let middle = 0.5 * (low + high);
+    (high.is_finite() && high - low < middle).then(|| Placed {
+        point: [middle * r.bearing.angle.cos(), middle * r.bearing.angle.sin()],
+        radius: 0.5 * (high - low) + high * r.bearing.uncertainty,
+    })
 }
 
 fn ratio(a: usize, b: usize) -> f64 {

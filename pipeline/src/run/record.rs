@@ -48,12 +48,17 @@ pub struct DetectionRecord {
     pub association: Association,
 }
 
-/// Range evidence for one detection: `[low, high]` in metres; `high` may be infinite.
+/// Range evidence for one detection: `[low, high]` in metres; an unbounded `high` is written
+/// `null` (JSON has no infinity).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RangeRecord {
+    #[serde(with = "optional_bounds")]
     pub ground: Option<[f64; 2]>,
+    #[serde(with = "optional_bounds")]
     pub stereo: Option<[f64; 2]>,
+    #[serde(with = "optional_bounds")]
     pub size: Option<[f64; 2]>,
+    #[serde(with = "bounds")]
     pub fused: [f64; 2],
     /// The cues' intervals did not overlap; `fused` is then their hull.
     pub conflict: bool,
@@ -113,4 +118,52 @@ pub struct StageSeconds {
     pub range: f64,
     pub associate: f64,
     pub map: f64,
+}
+
+/// `[low, high]` with an infinite `high` as `null`.
+mod bounds {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(value: &[f64; 2], s: S) -> Result<S::Ok, S::Error> {
+        (value[0], value[1].is_finite().then_some(value[1])).serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+        let (low, high) = <(f64, Option<f64>)>::deserialize(d)?;
+        Ok([low, high.unwrap_or(f64::INFINITY)])
+    }
+}
+
+mod optional_bounds {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(value: &Option<[f64; 2]>, s: S) -> Result<S::Ok, S::Error> {
+        value
+            .map(|v| (v[0], v[1].is_finite().then_some(v[1])))
+            .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+        let value = <Option<(f64, Option<f64>)>>::deserialize(d)?;
+        Ok(value.map(|(low, high)| [low, high.unwrap_or(f64::INFINITY)]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unbounded_ranges_round_trip_through_json() {
+        let record = RangeRecord {
+            ground: Some([2.0, f64::INFINITY]),
+            stereo: None,
+            size: Some([1.0, 3.0]),
+            fused: [2.0, f64::INFINITY],
+            conflict: false,
+        };
+        let text = serde_json::to_string(&record).unwrap();
+        assert!(text.contains("null"), "{text}");
+        assert_eq!(serde_json::from_str::<RangeRecord>(&text).unwrap(), record);
+    }
 }
