@@ -11,9 +11,10 @@
 
 mod components;
 mod score;
+mod split;
 
 use crate::calib::Calibration;
-use components::{label_wrapped, Blob};
+use components::{blob_of, label_wrapped, Blob};
 use imageproc::distance_transform::Norm;
 use imageproc::morphology::close_mut;
 use kornia_image::{Image, ImageSize};
@@ -36,6 +37,11 @@ pub struct DetectorSettings {
     /// `dark_chroma_drop`: the shaded side of a rock, told from cast shadows (which stay red).
     pub dark_ratio: f32,
     pub dark_chroma_drop: f32,
+    /// A blob is cut where its bottom edge lies this many rows (at least) under the concave
+    /// hull of its bottom edge: one rock's bottom edge is concave, touching rocks notch it.
+    pub split_depth_px: f32,
+    /// … or this fraction of the blob's height, if more (ragged edges grow with size).
+    pub split_depth_fraction: f32,
 }
 
 impl Default for DetectorSettings {
@@ -47,6 +53,8 @@ impl Default for DetectorSettings {
             bright_ratio: 1.25,
             dark_ratio: 0.6,
             dark_chroma_drop: 0.02,
+            split_depth_px: 3.0,
+            split_depth_fraction: 0.15,
         }
     }
 }
@@ -65,6 +73,9 @@ pub struct Detection {
     /// Continuous row of the bottom edge of the rock itself (its ground contact).
     pub contact_row: f64,
     pub appearance: Appearance,
+    /// May be several rocks (its bottom edge is notched, but too shallowly to cut), or only the
+    /// visible part of a rock cut from a nearer one in front of it: do not use its bearing.
+    pub ambiguous: bool,
 }
 
 /// Statistics that change little with viewpoint, for associating a rock across panoramas.
@@ -109,19 +120,29 @@ pub fn detect(
     ) else {
         return Vec::new();
     };
-    let blobs = label_wrapped(&mask, w, rows, |i| {
+    let sample = |col: usize, row: usize| {
+        let i = row * w + col;
         let p = &raw[3 * i..3 * i + 3];
         let sum = f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2]);
-        let ratio = sum / background[i / w].0.max(1.0);
+        let ratio = sum / background[row].0.max(1.0);
         PixelSample {
             rgb: [f32::from(p[0]), f32::from(p[1]), f32::from(p[2])],
             ratio,
             dark: ratio < settings.dark_ratio,
         }
-    });
-    let mut detections: Vec<Detection> = blobs
+    };
+    let rule = split::SplitRule {
+        min_depth: settings.split_depth_px,
+        fraction: settings.split_depth_fraction,
+        min_columns: 3,
+    };
+    let mut detections: Vec<Detection> = label_wrapped(&mask, w, rows)
         .into_iter()
-        .filter_map(|b| accept(b, top, calib, settings))
+        .flat_map(|c| split::split(c, rule))
+        .filter_map(|piece| {
+            let blob = blob_of(&piece.pixels, w, &sample);
+            accept(blob, piece.ambiguous, top, calib, settings)
+        })
         .collect();
     detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
     detections
@@ -201,6 +222,7 @@ fn segment(
 /// `min_width_m` or farther than `max_range_m`.
 fn accept(
     blob: Blob,
+    ambiguous: bool,
     top: usize,
     calib: &Calibration,
     settings: &DetectorSettings,
@@ -237,5 +259,6 @@ fn accept(
             texture: (variance.sqrt() / mean_luminance.max(1.0)) as f32,
             dark_fraction: (f64::from(blob.dark) / n) as f32,
         },
+        ambiguous,
     })
 }
