@@ -1,7 +1,9 @@
 //! The rock detector against the renderer's per-pixel rock ids: full-resolution stations of
 //! both presets, the low-resolution demo set, and images it must survive. Thresholds are the
-//! measured figures less a margin (`qrm-bench --detect DIR` gives full-set numbers);
-//! merges of rocks that overlap in the image are the main loss in the clustered Mars Yard.
+//! measured figures less a margin (`qrm-bench --detect DIR` gives full-set numbers). Blobs
+//! of touching rocks are cut; pieces that may be partly hidden behind a nearer rock, and
+//! notched blobs too shallow to cut, are flagged ambiguous and not counted as found: that is
+//! the main loss of recall in the clustered Mars Yard, the price of sound bearings.
 
 use qrm::calib::Calibration;
 use qrm::dataset::{visible_rocks, Counts, Preset, Truth};
@@ -37,8 +39,9 @@ fn check(score: &Score, precision: f64, recall: f64) {
     let (bearing, _) = median_and_max(&score.bearing_errors);
     let (contact, _) = median_and_max(&score.contact_errors);
     println!(
-        "{} detectable, {} found, {} false, {} splits, {} merged: precision {:.3} recall {:.3} bearing median {bearing:.2} px contact median {contact:.2} px",
+        "{} detectable, {} found, {} false, {} splits, {} merged, {} ambiguous, {} outside the bearing bound: precision {:.3} recall {:.3} bearing median {bearing:.2} px contact median {contact:.2} px",
         score.detectable, score.found, score.false_alarms, score.splits, score.merged,
+        score.ambiguous, score.outside_bound,
         score.precision(),
         score.recall()
     );
@@ -51,16 +54,21 @@ fn check(score: &Score, precision: f64, recall: f64) {
     assert!(score.recall() >= recall, "recall {}", score.recall());
     assert!(bearing <= 1.5, "bearing median {bearing}");
     assert!(contact <= 1.5, "contact median {contact}");
+    assert!(
+        score.outside_bound * 10 <= score.found,
+        "{} found rocks outside 1 px + 0.3 × width",
+        score.outside_bound
+    );
 }
 
 #[test]
 fn random_full_resolution() {
-    check(&score_stations(Preset::Random, &[0, 9, 23]), 0.8, 0.85);
+    check(&score_stations(Preset::Random, &[0, 9, 23]), 0.9, 0.8);
 }
 
 #[test]
 fn marsyard_full_resolution() {
-    check(&score_stations(Preset::Marsyard, &[0, 17, 33]), 0.75, 0.65);
+    check(&score_stations(Preset::Marsyard, &[0, 17, 33]), 0.88, 0.55);
 }
 
 /// The demo set at 1024 × 192: a quarter of the resolution, so the same settings see fewer
@@ -85,7 +93,7 @@ fn demo_set_low_resolution() {
             &settings,
         );
     }
-    check(&score, 0.9, 0.55);
+    check(&score, 0.95, 0.5);
 }
 
 /// A blank panorama, one of the wrong size and a black one give no detections and no panic.

@@ -106,12 +106,17 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
         let (bearing_median, bearing_max) = median_and_max(&score.bearing_errors);
         let (contact_median, contact_max) = median_and_max(&score.contact_errors);
         println!(
-            "detect: {} detectable, {} found, {} false, {} splits, {} merged: precision {:.3}, recall {:.3}",
-            score.detectable, score.found, score.false_alarms, score.splits, score.merged,
+            "detect: {} detectable, {} found, {} false, {} splits, {} merged, {} ambiguous: precision {:.3}, recall {:.3}",
+            score.detectable, score.found, score.false_alarms, score.splits, score.merged, score.ambiguous,
             score.precision(), score.recall()
         );
         println!(
             "detect: bearing error median {bearing_median:.2} px, max {bearing_max:.2} px; contact row error median {contact_median:.2} px, max {contact_max:.2} px"
+        );
+        let (_, worst_ratio) = median_and_max(&score.bearing_ratios);
+        println!(
+            "detect: bearing error over width max {worst_ratio:.2}; {} found rocks outside 1 px + 0.3 × width",
+            score.outside_bound
         );
     }
     Ok(())

@@ -6,8 +6,8 @@ use super::PixelSample;
 use kornia_image::Image;
 use kornia_imgproc::connected_components::{connected_components, Connectivity};
 
-/// Pixel statistics of one merged component; columns of a seam-straddling blob are unwrapped
-/// (its left part shifted by the width), so `col_max` may reach past the width.
+/// Pixel statistics of one blob; columns of a seam-straddling blob are unwrapped (its left
+/// part shifted by the width), so `col_max` may reach past the width.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Blob {
     pub pixels: u32,
@@ -24,6 +24,37 @@ pub(super) struct Blob {
     pub dark: u32,
 }
 
+impl Blob {
+    fn empty() -> Blob {
+        Blob {
+            col_min: usize::MAX,
+            row_min: usize::MAX,
+            ..Blob::default()
+        }
+    }
+
+    fn add(&mut self, col: usize, row: usize, s: &PixelSample) {
+        self.pixels += 1;
+        self.col_min = self.col_min.min(col);
+        self.col_max = self.col_max.max(col);
+        self.row_min = self.row_min.min(row);
+        self.row_max = self.row_max.max(row);
+        self.sum_col += col as f64 + 0.5;
+        self.sum_row += row as f64 + 0.5;
+        let luminance = f64::from(s.rgb[0] + s.rgb[1] + s.rgb[2]);
+        for (acc, c) in self.sum_rgb.iter_mut().zip(s.rgb) {
+            *acc += f64::from(c);
+        }
+        self.sum_luminance += luminance;
+        self.sum_luminance_sq += luminance * luminance;
+        self.sum_ratio += f64::from(s.ratio);
+        self.dark += u32::from(s.dark);
+    }
+}
+
+/// One connected component: its pixels as (unwrapped column, row), in row-major order.
+pub(super) type Component = Vec<(u32, u32)>;
+
 fn find(parent: &mut [usize], mut x: usize) -> usize {
     while parent[x] != x {
         parent[x] = parent[parent[x]];
@@ -32,14 +63,8 @@ fn find(parent: &mut [usize], mut x: usize) -> usize {
     x
 }
 
-/// The components of `mask` (`w` × `rows`, nonzero = set), merged across the seam, with the
-/// statistics of `sample(pixel index)` over their pixels.
-pub(super) fn label_wrapped(
-    mask: &Image<u8, 1>,
-    w: usize,
-    rows: usize,
-    sample: impl Fn(usize) -> PixelSample,
-) -> Vec<Blob> {
+/// The components of `mask` (`w` × `rows`, nonzero = set), merged across the seam.
+pub(super) fn label_wrapped(mask: &Image<u8, 1>, w: usize, rows: usize) -> Vec<Component> {
     let Ok(mut labels) = Image::<i32, 1>::from_size_val(mask.size(), 0) else {
         return Vec::new();
     };
@@ -68,35 +93,31 @@ pub(super) fn label_wrapped(
         wraps[find(&mut parent, left)] = true;
     }
     let roots: Vec<usize> = (0..parent.len()).map(|l| find(&mut parent, l)).collect();
-    let mut blobs: Vec<Option<Blob>> = vec![None; parent.len()];
-    for (i, &label) in labels.iter().enumerate() {
-        if label <= 0 {
-            continue;
+    let mut components: Vec<Component> = vec![Vec::new(); parent.len()];
+    for (y, row) in labels.chunks_exact(w).enumerate() {
+        for (x, &label) in row.iter().enumerate() {
+            if label <= 0 {
+                continue;
+            }
+            let root = roots[label as usize];
+            let col = if wraps[root] && x < w / 2 { x + w } else { x };
+            components[root].push((col as u32, y as u32));
         }
-        let root = roots[label as usize];
-        let (x, y) = (i % w, i / w);
-        let col = if wraps[root] && x < w / 2 { x + w } else { x };
-        let s = sample(i);
-        let b = blobs[root].get_or_insert_with(|| Blob {
-            col_min: usize::MAX,
-            row_min: usize::MAX,
-            ..Blob::default()
-        });
-        b.pixels += 1;
-        b.col_min = b.col_min.min(col);
-        b.col_max = b.col_max.max(col);
-        b.row_min = b.row_min.min(y);
-        b.row_max = b.row_max.max(y);
-        b.sum_col += col as f64 + 0.5;
-        b.sum_row += y as f64 + 0.5;
-        let luminance = f64::from(s.rgb[0] + s.rgb[1] + s.rgb[2]);
-        for (acc, c) in b.sum_rgb.iter_mut().zip(s.rgb) {
-            *acc += f64::from(c);
-        }
-        b.sum_luminance += luminance;
-        b.sum_luminance_sq += luminance * luminance;
-        b.sum_ratio += f64::from(s.ratio);
-        b.dark += u32::from(s.dark);
     }
-    blobs.into_iter().flatten().collect()
+    components.retain(|c| !c.is_empty());
+    components
+}
+
+/// The statistics of `pixels` with `sample(column mod w, row)`.
+pub(super) fn blob_of(
+    pixels: &[(u32, u32)],
+    w: usize,
+    sample: &impl Fn(usize, usize) -> PixelSample,
+) -> Blob {
+    let mut blob = Blob::empty();
+    for &(col, row) in pixels {
+        let (col, row) = (col as usize, row as usize);
+        blob.add(col, row, &sample(col % w, row));
+    }
+    blob
 }

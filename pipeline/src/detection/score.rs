@@ -22,6 +22,12 @@ pub struct Score {
     pub bearing_errors: Vec<f64>,
     /// |contact row − truth contact row| (pixels) of found rocks whose contact is in the image.
     pub contact_errors: Vec<f64>,
+    /// Bearing error over detection width (columns) of found rocks.
+    pub bearing_ratios: Vec<f64>,
+    /// Found rocks whose bearing error exceeds the downstream bound `1 px + 0.3 × width`.
+    pub outside_bound: usize,
+    /// Detections flagged ambiguous: left out of the matching (the downstream skips them).
+    pub ambiguous: usize,
 }
 
 fn column_gap(a: f64, b: f64, width: f64) -> f64 {
@@ -65,6 +71,10 @@ impl Score {
         let mut hits = vec![0usize; truth.len()];
         let mut first: Vec<Option<&Detection>> = vec![None; truth.len()];
         for d in detections {
+            if d.ambiguous {
+                self.ambiguous += 1;
+                continue;
+            }
             let owner = truth
                 .iter()
                 .enumerate()
@@ -97,14 +107,20 @@ impl Score {
             if let Some(d) = first[i] {
                 self.found += 1;
                 self.splits += hits[i] - 1;
-                self.bearing_errors
-                    .push(column_gap(d.centroid[0], t.bearing_column, width));
+                let error = column_gap(d.centroid[0], t.bearing_column, width);
+                let columns = f64::from(d.bbox[2] - d.bbox[0] + 1);
+                self.bearing_errors.push(error);
+                self.bearing_ratios.push(error / columns);
+                if error > 1.0 + 0.3 * columns {
+                    self.outside_bound += 1;
+                }
                 if t.contact[1] < f64::from(calib.image.height) {
                     self.contact_errors
                         .push((d.contact_row - t.contact[1]).abs());
                 }
             } else if detections.iter().any(|d| {
-                within_columns(t.centroid[0], d.bbox[0], d.bbox[2], width, 0.0)
+                !d.ambiguous
+                    && within_columns(t.centroid[0], d.bbox[0], d.bbox[2], width, 0.0)
                     && t.centroid[1] >= f64::from(d.bbox[1])
                     && t.centroid[1] <= f64::from(d.bbox[3]) + 1.0
             }) {
