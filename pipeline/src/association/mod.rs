@@ -27,6 +27,7 @@ use crate::detection::Appearance;
 use crate::map::{Hypergraph, LandmarkId};
 use crate::measurement::Panorama;
 use crate::ranging::RangeInterval;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Slack of the placement test against a registered frame, metres: generous, since ruling
@@ -50,7 +51,7 @@ impl Default for AssociationSettings {
     fn default() -> AssociationSettings {
         AssociationSettings {
             scales: AppearanceScales::default(),
-            gate: 4.0,
+            gate: 5.0,
             informative_triples: 6,
             tested_pairs: 40,
         }
@@ -94,6 +95,7 @@ pub fn associate<C: Calculus>(
         .map(|e| proposals(e, gallery, settings))
         .collect();
     let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
+    let recent = |l: LandmarkId| frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
     let registrations: Vec<(&Frame, Registration)> = frames
         .iter()
         .filter_map(|frame| Some((frame, register(placed, frame, &alike)?)))
@@ -143,9 +145,10 @@ pub fn associate<C: Calculus>(
     let anchored: Vec<(usize, LandmarkId)> = anchors.iter().map(|a| (a.0, a.1)).collect();
 
     let mut decisions: Vec<Decision> = (0..n)
+        .into_par_iter()
         .map(|i| match anchored.iter().find(|a| a.0 == i) {
             Some(&(_, landmark)) => Decision::Matched(landmark),
-            None => decide(map, panorama, i, &candidates[i], &anchored, settings),
+            None => decide(map, panorama, i, &candidates[i], &anchored, &recent, settings),
         })
         .collect();
     // Two detections may not be one landmark: hold both back.
@@ -178,7 +181,7 @@ pub fn reconsider<C: Calculus>(
         .filter(|l| !decided.iter().any(|d| d.1 == **l))
         .map(|&l| (l, settings.gate))
         .collect();
-    decide(map, panorama, detection, &open, decided, settings)
+    decide(map, panorama, detection, &open, decided, &|_| true, settings)
 }
 
 /// Landmarks whose looks are within the gate, nearest first.
@@ -275,14 +278,22 @@ fn decide<C: Calculus>(
     detection: usize,
     candidates: &[(LandmarkId, f64)],
     anchors: &[(usize, LandmarkId)],
+    recent: &dyn Fn(LandmarkId) -> bool,
     settings: &AssociationSettings,
 ) -> Decision {
     let taken = |l: LandmarkId| anchors.iter().any(|a| a.1 == l);
     let mut survivors: Vec<(LandmarkId, usize)> = Vec::new();
     for &(landmark, _) in candidates.iter().filter(|c| !taken(c.0)) {
         match test_candidate(map, panorama, detection, landmark, anchors, settings) {
-            Some(informative) => survivors.push((landmark, informative)),
-            None => continue,
+            // A landmark not seen lately stays a candidate only on evidence the map actually
+            // constrains: otherwise every unknown rock would be held back for every old
+            // look-alike, and the map would stop growing.
+            Some(informative)
+                if recent(landmark) || informative >= settings.informative_triples =>
+            {
+                survivors.push((landmark, informative))
+            }
+            _ => continue,
         }
     }
     match survivors.as_slice() {

@@ -18,7 +18,7 @@ use std::f64::consts::FRAC_PI_2;
 use std::ops::{Add, Sub};
 
 /// Halvings of the range box: the smallest boxes are 2⁻¹⁰ wide in each range.
-pub const MAX_DEPTH: u32 = 20;
+pub const MAX_DEPTH: u32 = 14;
 
 /// A closed interval of reals.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -51,8 +51,8 @@ pub struct SensorModel {
 impl Default for SensorModel {
     fn default() -> SensorModel {
         SensorModel {
-            bearing_error_px: 1.0,
-            bearing_error_per_width: 0.3,
+            bearing_error_px: 1.5,
+            bearing_error_per_width: 0.15,
             contact_error_px: 1.5,
             reach_per_width: 0.75,
             disparity_error_px: 1.5,
@@ -217,6 +217,19 @@ fn ground_cue(
         return None;
     }
     Some(RangeInterval::new(centre(near), centre(far) / (1.0 - k)))
+}
+
+/// Whether detection `index` touches another one side by side (columns within two of each
+/// other, rows overlapping): the two may be pieces of one rock, or two rocks cut apart where
+/// they touch, and either way its centroid may be far from its rock's centre.
+pub fn touches_neighbour(index: usize, all: &[Detection], width: u32) -> bool {
+    let me = &all[index];
+    all.iter().enumerate().any(|(j, other)| {
+        j != index
+            && columns_overlap(me.bbox, other.bbox, 2, width)
+            && other.bbox[1] <= me.bbox[3]
+            && me.bbox[1] <= other.bbox[3]
+    })
 }
 
 /// Whether another detection overlaps `index`'s columns and reaches down to or below its

@@ -128,9 +128,19 @@ impl<C: Calculus> Mapper<C> {
             &self.sensor,
         );
         record.seconds.range = start.elapsed().as_secs_f64();
-        // Detections whose bearing is too uncertain to measure with are not used.
+        // Detections the detector doubts (possibly several rocks, or part of one), pieces
+        // touching another piece, and those whose bearing is too uncertain to measure with are
+        // not used.
+        let width = self.calib.image.width;
+        let narrowest = MIN_COLUMNS.max(width / 512);
         let usable: Vec<usize> = (0..ranged.len())
-            .filter(|&i| ranged[i].bearing.uncertainty < MAX_BEARING_UNCERTAINTY)
+            .filter(|&i| {
+                let d = &station.primary[i];
+                !d.ambiguous
+                    && d.bbox[2] + 1 >= d.bbox[0] + narrowest
+                    && !ranging::touches_neighbour(i, &station.primary, width)
+                    && ranged[i].bearing.uncertainty < MAX_BEARING_UNCERTAINTY
+            })
             .collect();
         record.detections = station
             .primary
@@ -332,6 +342,10 @@ impl<C: Calculus> Mapper<C> {
         }
     }
 }
+
+/// Narrowest usable detection, columns (at least a 512th of the panorama): slivers are mostly
+/// pieces of larger rocks, whose centroids say little about where the rock is.
+const MIN_COLUMNS: u32 = 3;
 
 /// Recent stations registered against (a rover moves a few metres between stations: the most
 /// recent ones share most landmarks with the current one).
