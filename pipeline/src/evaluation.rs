@@ -216,7 +216,8 @@ pub fn evaluate_run(
         eval.detection.detections += record.detections.len();
         eval.detection.true_detections += matches.iter().flatten().count();
         for r in &image.rocks {
-            let columns = (f64::from(r.bbox[2]) - f64::from(r.bbox[0])).rem_euclid(f64::from(width)) + 1.0;
+            let columns =
+                (f64::from(r.bbox[2]) - f64::from(r.bbox[0])).rem_euclid(f64::from(width)) + 1.0;
             let physical = columns * calib.column_width() * r.range;
             if r.range <= detectable.max_range_m && physical >= detectable.min_width_m {
                 eval.detection.detectable += 1;
@@ -243,10 +244,19 @@ pub fn evaluate_run(
             if d.bearing_uncertainty > 0.0 {
                 worst_ratio = worst_ratio.max(error / d.bearing_uncertainty);
             }
-            let cues = [d.range.ground, d.range.stereo, d.range.size, Some(d.range.fused)];
+            let cues = [
+                d.range.ground,
+                d.range.stereo,
+                d.range.size,
+                Some(d.range.fused),
+            ];
             for (k, cue) in cues.iter().enumerate() {
                 if let Some([low, high]) = cue {
-                    let width = if high.is_finite() { (high - low) / range } else { f64::INFINITY };
+                    let width = if high.is_finite() {
+                        (high - low) / range
+                    } else {
+                        f64::INFINITY
+                    };
                     cue_checks[k].push(((*low..=*high).contains(&range), width));
                 }
             }
@@ -278,14 +288,24 @@ pub fn evaluate_run(
     eval.bearing = BearingScore {
         count: bearing_errors.len(),
         median_error_deg: median(bearing_errors.clone()).to_degrees(),
-        worst_error_deg: bearing_errors.iter().copied().fold(0.0, f64::max).to_degrees(),
+        worst_error_deg: bearing_errors
+            .iter()
+            .copied()
+            .fold(0.0, f64::max)
+            .to_degrees(),
         within_interval: ratio(within, bearing_errors.len()),
         worst_error_ratio: worst_ratio,
     };
     let cue = |checks: &Vec<(bool, f64)>| CueScore {
         count: checks.len(),
         holds_truth: ratio(checks.iter().filter(|c| c.0).count(), checks.len()),
-        median_relative_width: median(checks.iter().map(|c| c.1).filter(|w| w.is_finite()).collect()),
+        median_relative_width: median(
+            checks
+                .iter()
+                .map(|c| c.1)
+                .filter(|w| w.is_finite())
+                .collect(),
+        ),
     };
     eval.range.ground = cue(&cue_checks[0]);
     eval.range.stereo = cue(&cue_checks[1]);
@@ -309,7 +329,10 @@ pub fn evaluate_run(
         if votes.len() > 1 {
             a.mixed_landmarks += 1;
         }
-        if let Some((&id, &count)) = votes.iter().max_by_key(|(id, c)| (**c, std::cmp::Reverse(**id))) {
+        if let Some((&id, &count)) = votes
+            .iter()
+            .max_by_key(|(id, c)| (**c, std::cmp::Reverse(**id)))
+        {
             a.correct_sightings += count;
             rock_of.insert(landmark.landmark, id);
             *landmarks_of_rock.entry(id).or_default() += 1;
@@ -388,13 +411,17 @@ fn exact_map(
             .map(|&l| {
                 let p = truth.rocks[defined(l).expect("filtered") as usize].position;
                 let (dx, dy) = (p[0] - station.position[0], p[1] - station.position[1]);
-                ((dy.atan2(dx) - station.heading).rem_euclid(TAU), dx.hypot(dy))
+                (
+                    (dy.atan2(dx) - station.heading).rem_euclid(TAU),
+                    dx.hypot(dy),
+                )
             })
             .collect();
         let mut nearest_first: Vec<usize> = (0..ids.len()).collect();
         nearest_first.sort_by(|&a, &b| polar[a].1.total_cmp(&polar[b].1));
         let order = RangeOrder::total(&nearest_first).expect("a permutation");
-        let Ok(panorama) = Panorama::new(polar.iter().map(|p| Bearing::exact(p.0)).collect(), order)
+        let Ok(panorama) =
+            Panorama::new(polar.iter().map(|p| Bearing::exact(p.0)).collect(), order)
         else {
             continue;
         };

@@ -220,7 +220,10 @@ mod tests {
         );
         let names: Vec<_> = survey.stations.iter().map(|s| s.name.as_str()).collect();
         assert_eq!(names, ["mono_2", "s_9", "s_10"]);
-        assert_eq!(survey.stations[1].right, Some(PathBuf::from("d/s_9_right.png")));
+        assert_eq!(
+            survey.stations[1].right,
+            Some(PathBuf::from("d/s_9_right.png"))
+        );
         assert_eq!(survey.stations[0].right, None);
         assert_eq!(survey.unpaired, vec![PathBuf::from("d/lonely_right.png")]);
     }

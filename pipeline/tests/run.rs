@@ -83,9 +83,18 @@ fn maps_the_demo_dataset_soundly() {
     assert_eq!(eval["map"]["run"]["unsound_relations"], 0, "{eval}");
     assert_eq!(eval["map"]["exact"]["unsound_relations"], 0, "{eval}");
     assert_eq!(eval["bearing"]["within_interval"], 1.0, "{eval}");
-    assert!(eval["association"]["accuracy"].as_f64().unwrap() >= 0.95, "{eval}");
-    assert!(eval["detection"]["recall"].as_f64().unwrap() >= 0.8, "{eval}");
-    assert!(eval["detection"]["precision"].as_f64().unwrap() >= 0.9, "{eval}");
+    assert!(
+        eval["association"]["accuracy"].as_f64().unwrap() >= 0.95,
+        "{eval}"
+    );
+    assert!(
+        eval["detection"]["recall"].as_f64().unwrap() >= 0.8,
+        "{eval}"
+    );
+    assert!(
+        eval["detection"]["precision"].as_f64().unwrap() >= 0.9,
+        "{eval}"
+    );
     // eval on its own gives the same scores.
     let again = scratch("demo-eval");
     let o = pipeline(&[
@@ -131,18 +140,37 @@ fn fatal_input_errors_exit_2_and_write_nothing() {
     ] {
         let out = scratch("fatal-out");
         let o = pipeline(&["run", "--images", arg(&images), "--out", arg(&out)]);
-        assert_eq!(o.status.code(), Some(2), "{}: {}", images.display(), stderr(&o));
-        assert!(stderr(&o).contains(&needle), "{}: {}", images.display(), stderr(&o));
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{}: {}",
+            images.display(),
+            stderr(&o)
+        );
+        assert!(
+            stderr(&o).contains(&needle),
+            "{}: {}",
+            images.display(),
+            stderr(&o)
+        );
         assert!(!stderr(&o).contains("panicked"));
         let written: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
-        assert!(written.is_empty(), "{}: wrote {written:?}", images.display());
+        assert!(
+            written.is_empty(),
+            "{}: wrote {written:?}",
+            images.display()
+        );
     }
     // An output path that is a file.
     let file = empty.join("a-file");
     std::fs::write(&file, b"x").unwrap();
     let o = pipeline(&["run", "--images", DEMO, "--out", arg(&file), "--no-eval"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("cannot create output directory"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("cannot create output directory"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]
@@ -162,12 +190,28 @@ fn a_bad_image_is_skipped_with_a_warning() {
         .unwrap();
     std::fs::remove_file(dir.join("station_003_right.png")).unwrap();
     let out = scratch("bad-images-out");
-    let o = pipeline(&["run", "--images", arg(&dir), "--out", arg(&out), "--no-eval"]);
+    let o = pipeline(&[
+        "run",
+        "--images",
+        arg(&dir),
+        "--out",
+        arg(&out),
+        "--no-eval",
+    ]);
     let err = stderr(&o);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("station_001_left.png") && err.contains("cannot decode"), "{err}");
-    assert!(err.contains("station_002_right.png") && err.contains("64×32"), "{err}");
-    assert!(err.contains("station_003") && err.contains("at least 3"), "{err}");
+    assert!(
+        err.contains("station_001_left.png") && err.contains("cannot decode"),
+        "{err}"
+    );
+    assert!(
+        err.contains("station_002_right.png") && err.contains("64×32"),
+        "{err}"
+    );
+    assert!(
+        err.contains("station_003") && err.contains("at least 3"),
+        "{err}"
+    );
     let summary = json(&out.join("summary.json"));
     assert_eq!(summary["stations"], 4);
     assert_eq!(summary["stations_skipped"], 1);

@@ -68,7 +68,9 @@ impl Gallery {
                 let n = p.sightings as f32;
                 let mix = |old: f32, new: f32| (old * n + new) / (n + 1.0);
                 p.appearance = Appearance {
-                    colour: std::array::from_fn(|k| mix(p.appearance.colour[k], appearance.colour[k])),
+                    colour: std::array::from_fn(|k| {
+                        mix(p.appearance.colour[k], appearance.colour[k])
+                    }),
                     brightness: mix(p.appearance.brightness, appearance.brightness),
                     texture: mix(p.appearance.texture, appearance.texture),
                     dark_fraction: mix(p.appearance.dark_fraction, appearance.dark_fraction),
@@ -98,7 +100,7 @@ pub fn distance(a: &Appearance, b: &Appearance, scales: &AppearanceScales) -> f6
     let log_ratio = (f64::from(a.brightness.max(1e-3)) / f64::from(b.brightness.max(1e-3))).ln();
     let brightness = (log_ratio / scales.log_brightness).powi(2);
     let texture = ((f64::from(a.texture) - f64::from(b.texture)) / scales.texture).powi(2);
-    let dark = ((f64::from(a.dark_fraction) - f64::from(b.dark_fraction)) / scales.dark_fraction)
-        .powi(2);
+    let dark =
+        ((f64::from(a.dark_fraction) - f64::from(b.dark_fraction)) / scales.dark_fraction).powi(2);
     (chroma + brightness + texture + dark).sqrt()
 }

@@ -53,7 +53,7 @@ impl Default for AssociationSettings {
             scales: AppearanceScales::default(),
             gate: 5.0,
             informative_triples: 6,
-            tested_pairs: 40,
+            tested_pairs: 20,
         }
     }
 }
@@ -108,9 +108,8 @@ pub fn associate<C: Calculus>(
         .collect();
     pairs.sort_unstable();
     pairs.dedup();
-    let conflicted = |&(i, l): &(usize, LandmarkId)| {
-        pairs.iter().any(|&(j, m)| (j == i) != (m == l))
-    };
+    let conflicted =
+        |&(i, l): &(usize, LandmarkId)| pairs.iter().any(|&(j, m)| (j == i) != (m == l));
     let mut anchors: Vec<(usize, LandmarkId, f64)> = pairs
         .iter()
         .filter(|p| !conflicted(p))
@@ -148,7 +147,23 @@ pub fn associate<C: Calculus>(
         .into_par_iter()
         .map(|i| match anchored.iter().find(|a| a.0 == i) {
             Some(&(_, landmark)) => Decision::Matched(landmark),
-            None => decide(map, panorama, i, &candidates[i], &anchored, &recent, settings),
+            None => decide(
+                map,
+                panorama,
+                i,
+                &candidates[i],
+                &anchored,
+                &recent,
+                &|l| {
+                    // Candidates of a registered frame were kept only if they lie where the
+                    // motion puts the detection: placement confirms them.
+                    registrations
+                        .iter()
+                        .any(|(frame, _)| frame.landmarks.iter().any(|m| m.0 == l))
+                        && placed[i].is_some()
+                },
+                settings,
+            ),
         })
         .collect();
     // Two detections may not be one landmark: hold both back.
@@ -181,7 +196,16 @@ pub fn reconsider<C: Calculus>(
         .filter(|l| !decided.iter().any(|d| d.1 == **l))
         .map(|&l| (l, settings.gate))
         .collect();
-    decide(map, panorama, detection, &open, decided, &|_| true, settings)
+    decide(
+        map,
+        panorama,
+        detection,
+        &open,
+        decided,
+        &|_| true,
+        &|_| false,
+        settings,
+    )
 }
 
 /// Landmarks whose looks are within the gate, nearest first.
@@ -255,13 +279,11 @@ fn drop_inconsistent_anchors<C: Calculus>(
             }
         }
         // The worst offender, the weaker appearance match on ties.
-        let worst = (0..k)
-            .filter(|&i| failures[i] > 0)
-            .max_by(|&i, &j| {
-                failures[i]
-                    .cmp(&failures[j])
-                    .then(anchors[i].2.total_cmp(&anchors[j].2))
-            });
+        let worst = (0..k).filter(|&i| failures[i] > 0).max_by(|&i, &j| {
+            failures[i]
+                .cmp(&failures[j])
+                .then(anchors[i].2.total_cmp(&anchors[j].2))
+        });
         match worst {
             Some(i) => {
                 anchors.remove(i);
@@ -279,6 +301,7 @@ fn decide<C: Calculus>(
     candidates: &[(LandmarkId, f64)],
     anchors: &[(usize, LandmarkId)],
     recent: &dyn Fn(LandmarkId) -> bool,
+    placed_near: &dyn Fn(LandmarkId) -> bool,
     settings: &AssociationSettings,
 ) -> Decision {
     let taken = |l: LandmarkId| anchors.iter().any(|a| a.1 == l);
@@ -298,7 +321,9 @@ fn decide<C: Calculus>(
     }
     match survivors.as_slice() {
         [] => Decision::New,
-        [(landmark, informative)] if *informative >= settings.informative_triples => {
+        [(landmark, informative)]
+            if *informative >= settings.informative_triples || placed_near(*landmark) =>
+        {
             Decision::Matched(*landmark)
         }
         _ => Decision::HeldBack(survivors.iter().map(|s| s.0).collect()),
@@ -322,8 +347,12 @@ fn test_candidate<C: Calculus>(
             let (p, q) = (anchors[x], anchors[y]);
             if let Some(r) = map.relation(landmark, p.1, q.1) {
                 let open = r.len() as u32
-                    + map.relation(p.1, q.1, landmark).map_or(0, |s| s.len() as u32)
-                    + map.relation(q.1, landmark, p.1).map_or(0, |s| s.len() as u32);
+                    + map
+                        .relation(p.1, q.1, landmark)
+                        .map_or(0, |s| s.len() as u32)
+                    + map
+                        .relation(q.1, landmark, p.1)
+                        .map_or(0, |s| s.len() as u32);
                 if open < 3 * C::universe().len() as u32 {
                     pairs.push((x, y, open));
                 }

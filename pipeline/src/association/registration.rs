@@ -62,7 +62,10 @@ pub fn register(
             if i1 == i2 || j1 == j2 {
                 continue;
             }
-            let (p1, p2) = (current[i1].expect("filtered"), current[i2].expect("filtered"));
+            let (p1, p2) = (
+                current[i1].expect("filtered"),
+                current[i2].expect("filtered"),
+            );
             let (q1, q2) = (frame.landmarks[j1].1, frame.landmarks[j2].1);
             let (dp, dq) = (distance(p1.point, p2.point), distance(q1.point, q2.point));
             let tolerance = p1.radius + p2.radius + q1.radius + q2.radius + 2.0 * SLACK_M;
@@ -91,7 +94,6 @@ pub fn register(
     }
     let (score, pairs) = best?;
     let count = pairs.len();
-    eprintln!("DEBUG register: {} placed, {} frame, {} corr, best {count} score {score:.2}, runner-up {runner_up:.2}", current.iter().flatten().count(), frame.landmarks.len(), correspondences.len());
     if count < MIN_INLIERS || score < runner_up + MARGIN {
         return None;
     }
@@ -100,7 +102,12 @@ pub fn register(
     let motion = Motion::fit(
         &pairs
             .iter()
-            .map(|&(i, j)| (current[i].expect("inlier").point, frame.landmarks[j].1.point))
+            .map(|&(i, j)| {
+                (
+                    current[i].expect("inlier").point,
+                    frame.landmarks[j].1.point,
+                )
+            })
             .collect::<Vec<_>>(),
     );
     let gap = |i: usize, j: usize| {
@@ -109,7 +116,9 @@ pub fn register(
             frame.landmarks[j].1.point,
         )
     };
-    let placed: Vec<usize> = (0..current.len()).filter(|&i| current[i].is_some()).collect();
+    let placed: Vec<usize> = (0..current.len())
+        .filter(|&i| current[i].is_some())
+        .collect();
     let pairs: Vec<(usize, LandmarkId)> = pairs
         .into_iter()
         .filter(|&(i, j)| {
@@ -117,11 +126,12 @@ pub fn register(
             let (p, q) = (current[i].expect("placed"), frame.landmarks[j].1);
             d <= p.radius + q.radius + SLACK_M
                 && (0..frame.landmarks.len()).all(|k| k == j || gap(i, k) > UNIQUE * d + SLACK_M)
-                && placed.iter().all(|&k| k == i || gap(k, j) > UNIQUE * d + SLACK_M)
+                && placed
+                    .iter()
+                    .all(|&k| k == i || gap(k, j) > UNIQUE * d + SLACK_M)
         })
         .map(|(i, j)| (i, frame.landmarks[j].0))
         .collect();
-    eprintln!("DEBUG unique pairs {}", pairs.len());
     (pairs.len() >= MIN_INLIERS).then(|| Registration {
         pairs,
         motion: [motion.cos, motion.sin, motion.shift[0], motion.shift[1]],
@@ -172,7 +182,10 @@ impl Motion {
     fn fit(pairs: &[([f64; 2], [f64; 2])]) -> Motion {
         let n = pairs.len() as f64;
         let mean = |f: fn(&([f64; 2], [f64; 2])) -> [f64; 2]| {
-            let sum = pairs.iter().map(f).fold([0.0, 0.0], |a, p| [a[0] + p[0], a[1] + p[1]]);
+            let sum = pairs
+                .iter()
+                .map(f)
+                .fold([0.0, 0.0], |a, p| [a[0] + p[0], a[1] + p[1]]);
             [sum[0] / n, sum[1] / n]
         };
         let (mp, mq) = (mean(|p| p.0), mean(|p| p.1));
@@ -244,7 +257,14 @@ mod tests {
 
     #[test]
     fn recovers_who_is_who_after_a_rigid_motion() {
-        let field = [[3.0, 1.0], [5.0, -2.0], [-4.0, 6.0], [0.5, -7.0], [8.0, 8.0], [-6.0, -3.0]];
+        let field = [
+            [3.0, 1.0],
+            [5.0, -2.0],
+            [-4.0, 6.0],
+            [0.5, -7.0],
+            [8.0, 8.0],
+            [-6.0, -3.0],
+        ];
         let (angle, shift) = (0.7f64, [1.5, -0.8]);
         let frame = Frame {
             landmarks: field

@@ -34,7 +34,8 @@ pub fn run(args: EvalArgs) -> Result<()> {
 fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("{} is not a valid file of its kind", path.display()))
+    serde_json::from_str(&text)
+        .with_context(|| format!("{} is not a valid file of its kind", path.display()))
 }
 
 /// Scores the run in `run_dir` against `truth_path`, writing `eval.json` into `out`.
@@ -87,7 +88,12 @@ fn print_report(e: &Evaluation) {
         b.worst_error_ratio
     );
     let r = &e.range;
-    for (name, c) in [("ground", &r.ground), ("stereo", &r.stereo), ("size", &r.size), ("fused", &r.fused)] {
+    for (name, c) in [
+        ("ground", &r.ground),
+        ("stereo", &r.stereo),
+        ("size", &r.size),
+        ("fused", &r.fused),
+    ] {
         println!(
             "  range cue {name:<6}: {} intervals, {:.1} % hold the truth, median width {:.0} % of range",
             c.count,

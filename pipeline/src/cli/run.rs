@@ -88,8 +88,11 @@ pub fn run(args: RunArgs) -> Result<()> {
     progress.finish_and_clear();
     let detect_wall = started.elapsed().as_secs_f64();
 
-    let mut mapper: Mapper<Edc> =
-        Mapper::new(calib, SensorModel::default(), AssociationSettings::default());
+    let mut mapper: Mapper<Edc> = Mapper::new(
+        calib,
+        SensorModel::default(),
+        AssociationSettings::default(),
+    );
     let mut records: Vec<StationRecord> = Vec::new();
     let mut skipped = Vec::new();
     let progress = bar(front.len(), "map");
@@ -129,10 +132,16 @@ pub fn run(args: RunArgs) -> Result<()> {
         (serde_json::to_string_pretty(&summary)? + "\n").as_bytes(),
     )?;
     println!("{summary}");
-    println!("total {:.2} s; outputs in {}", started.elapsed().as_secs_f64(), args.out.display());
-    println!("  look at {} (the RNG) and {} (the map, docs/MAP_FORMAT.md)",
+    println!(
+        "total {:.2} s; outputs in {}",
+        started.elapsed().as_secs_f64(),
+        args.out.display()
+    );
+    println!(
+        "  look at {} (the RNG) and {} (the map, docs/MAP_FORMAT.md)",
         args.out.join("rng.png").display(),
-        args.out.join("map.json").display());
+        args.out.join("map.json").display()
+    );
 
     let truth = args.truth.clone().or_else(|| {
         let default = args.images.join("truth.json");
@@ -148,7 +157,10 @@ pub fn run(args: RunArgs) -> Result<()> {
 fn write_outputs(out: &Path, mapper: &Mapper<Edc>, records: &[StationRecord]) -> Result<()> {
     write_atomic(&out.join("map.json"), mapper.map.to_json().as_bytes())?;
     let rng = estimate(&mapper.map).expect("EDC has a lune");
-    write_atomic(&out.join("rng.json"), rng_json(&mapper.map, &rng).as_bytes())?;
+    write_atomic(
+        &out.join("rng.json"),
+        rng_json(&mapper.map, &rng).as_bytes(),
+    )?;
     let ids = mapper.map.landmarks();
     let index = |id: u32| ids.iter().position(|&l| l == id).expect("edge of the map");
     let edges: Vec<(usize, usize, f64)> = rng

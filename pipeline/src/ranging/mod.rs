@@ -180,9 +180,7 @@ fn fuse(cues: [Option<RangeInterval>; 3]) -> (RangeInterval, bool) {
         return (RangeInterval::unbounded(), false);
     };
     let rest: Vec<RangeInterval> = present.collect();
-    let intersection = rest
-        .iter()
-        .try_fold(first, |acc, &c| acc.intersection(c));
+    let intersection = rest.iter().try_fold(first, |acc, &c| acc.intersection(c));
     match intersection {
         Some(fused) => (fused, false),
         None => (rest.iter().fold(first, |acc, &c| acc.hull(c)), true),
@@ -287,8 +285,8 @@ fn bearing_of(
     range: RangeInterval,
 ) -> Bearing {
     let left = calib.azimuth(d.centroid[0]);
-    let error =
-        (model.bearing_error_px + model.bearing_error_per_width * apparent_columns(d)) * calib.column_width();
+    let error = (model.bearing_error_px + model.bearing_error_per_width * apparent_columns(d))
+        * calib.column_width();
     let (angle, spread) = match right {
         Some(r) => {
             let difference = azimuth_difference(calib.azimuth(r.centroid[0]), left);
@@ -325,10 +323,19 @@ mod tests {
     fn fusion_intersects_and_flags_conflicts() {
         let a = RangeInterval::new(2.0, 6.0);
         let b = RangeInterval::new(4.0, 9.0);
-        assert_eq!(fuse([Some(a), Some(b), None]), (RangeInterval::new(4.0, 6.0), false));
+        assert_eq!(
+            fuse([Some(a), Some(b), None]),
+            (RangeInterval::new(4.0, 6.0), false)
+        );
         let c = RangeInterval::new(7.0, 8.0);
-        assert_eq!(fuse([Some(a), None, Some(c)]), (RangeInterval::new(2.0, 8.0), true));
-        assert_eq!(fuse([None, None, None]), (RangeInterval::unbounded(), false));
+        assert_eq!(
+            fuse([Some(a), None, Some(c)]),
+            (RangeInterval::new(2.0, 8.0), true)
+        );
+        assert_eq!(
+            fuse([None, None, None]),
+            (RangeInterval::unbounded(), false)
+        );
     }
 
     #[test]
@@ -341,7 +348,17 @@ mod tests {
     fn column_overlap_across_the_seam() {
         // [4090, 4100] wraps to columns 4090..4095 and 0..4; [0, 3] overlaps it.
         assert!(columns_overlap([4090, 0, 4100, 10], [0, 0, 3, 10], 0, 4096));
-        assert!(!columns_overlap([4090, 0, 4100, 10], [6, 0, 9, 10], 0, 4096));
-        assert!(!columns_overlap([100, 0, 110, 10], [120, 0, 130, 10], 2, 4096));
+        assert!(!columns_overlap(
+            [4090, 0, 4100, 10],
+            [6, 0, 9, 10],
+            0,
+            4096
+        ));
+        assert!(!columns_overlap(
+            [100, 0, 110, 10],
+            [120, 0, 130, 10],
+            2,
+            4096
+        ));
     }
 }

@@ -20,7 +20,12 @@ pub fn match_stereo(
 ) -> Vec<Option<usize>> {
     let cost: Vec<Vec<Option<f64>>> = left
         .iter()
-        .map(|l| right.iter().map(|r| pair_cost(l, r, calib, model)).collect())
+        .map(|l| {
+            right
+                .iter()
+                .map(|r| pair_cost(l, r, calib, model))
+                .collect()
+        })
         .collect();
     let best_right = |i: usize| best_of(cost[i].iter().copied().enumerate());
     let best_left = |j: usize| best_of(cost.iter().map(|row| row[j]).enumerate());
@@ -44,17 +49,19 @@ fn best_of(candidates: impl Iterator<Item = (usize, Option<f64>)>) -> Option<(us
 }
 
 /// Dissimilarity of a left and a right detection, or `None` if they cannot be one rock.
-fn pair_cost(l: &Detection, r: &Detection, calib: &Calibration, model: &SensorModel) -> Option<f64> {
+fn pair_cost(
+    l: &Detection,
+    r: &Detection,
+    calib: &Calibration,
+    model: &SensorModel,
+) -> Option<f64> {
     let column_width = calib.column_width();
     let width = |d: &Detection| f64::from(d.bbox[2].saturating_sub(d.bbox[0]) + 1);
     let height = |d: &Detection| f64::from(d.bbox[3].saturating_sub(d.bbox[1]) + 1);
     let tolerance = (model.disparity_error_px
         + model.disparity_error_per_width * 0.5 * (width(l) + width(r)))
         * column_width;
-    let disparity = azimuth_difference(
-        calib.azimuth(r.centroid[0]),
-        calib.azimuth(l.centroid[0]),
-    );
+    let disparity = azimuth_difference(calib.azimuth(r.centroid[0]), calib.azimuth(l.centroid[0]));
     let largest = calib.stereo_disparity(model.min_range_m);
     if disparity < -tolerance || disparity > largest + tolerance {
         return None;

@@ -26,12 +26,7 @@ pub fn detect_station(
     settings: &DetectorSettings,
 ) -> FrontEndResult {
     let size = (calib.image.width, calib.image.height);
-    let name = |p: &Path| {
-        p.strip_prefix(directory)
-            .unwrap_or(p)
-            .display()
-            .to_string()
-    };
+    let name = |p: &Path| p.strip_prefix(directory).unwrap_or(p).display().to_string();
     let mut decode_seconds = 0.0;
     let mut detect_seconds = 0.0;
     let mut timed_read = |path: &Path| {
@@ -51,16 +46,19 @@ pub fn detect_station(
         }
     };
     let mut warnings = Vec::new();
-    let right = station.right.as_ref().and_then(|path| match timed_read(path) {
-        Ok(image) => Some(image),
-        Err(e) => {
-            warnings.push(format!(
-                "station {}: right panorama unusable, no stereo cue: {e}",
-                station.name
-            ));
-            None
-        }
-    });
+    let right = station
+        .right
+        .as_ref()
+        .and_then(|path| match timed_read(path) {
+            Ok(image) => Some(image),
+            Err(e) => {
+                warnings.push(format!(
+                    "station {}: right panorama unusable, no stereo cue: {e}",
+                    station.name
+                ));
+                None
+            }
+        });
     let start = Instant::now();
     let primary_detections = detect(&primary, calib, settings);
     let right_detections = right.as_ref().map(|r| detect(r, calib, settings));

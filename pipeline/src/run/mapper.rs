@@ -2,9 +2,7 @@
 //! (000 §VI-C) turn detections into measurements, fused into the map (000 §VI-B); held-back
 //! observations are retried after every station.
 
-use super::record::{
-    Association, DetectionRecord, MetricsRecord, RangeRecord, StationRecord,
-};
+use super::record::{Association, DetectionRecord, MetricsRecord, RangeRecord, StationRecord};
 use crate::association::{
     associate, reconsider, AssociationSettings, Decision, Evidence, Frame, Gallery, Placed,
 };
@@ -309,9 +307,13 @@ impl<C: Calculus> Mapper<C> {
                     if landmark == self.next_landmark {
                         self.next_landmark += 1;
                     }
-                    self.gallery
-                        .observe(landmark, item.evidence.appearance.clone(), item.evidence.width);
-                    self.sightings.push((item.station, item.primary_index, landmark));
+                    self.gallery.observe(
+                        landmark,
+                        item.evidence.appearance.clone(),
+                        item.evidence.width,
+                    );
+                    self.sightings
+                        .push((item.station, item.primary_index, landmark));
                     resolved += 1;
                 }
                 Err(contradiction) => record.warnings.push(format!(
@@ -353,7 +355,7 @@ const RECENT_FRAMES: usize = 6;
 
 /// Stations a held-back observation waits for the map to tighten before it is given up (an
 /// observation not fused loses information, never soundness).
-const HOLD_STATIONS: usize = 3;
+const HOLD_STATIONS: usize = 2;
 
 /// A detection's rough position around the station, if its range is bounded well enough to
 /// place it: the middle of its range interval along its bearing.
@@ -361,7 +363,10 @@ fn placed(r: &Ranged) -> Option<Placed> {
     let [low, high] = r.fused.as_array();
     let middle = 0.5 * (low + high);
     (high.is_finite() && high - low < middle).then(|| Placed {
-        point: [middle * r.bearing.angle.cos(), middle * r.bearing.angle.sin()],
+        point: [
+            middle * r.bearing.angle.cos(),
+            middle * r.bearing.angle.sin(),
+        ],
         radius: 0.5 * (high - low) + high * r.bearing.uncertainty,
     })
 }

@@ -43,7 +43,10 @@ impl RunSummary {
         wall_front_end: f64,
         wall_mapping: f64,
     ) -> RunSummary {
-        let last = records.last().map(|r| r.metrics.clone()).unwrap_or_default();
+        let last = records
+            .last()
+            .map(|r| r.metrics.clone())
+            .unwrap_or_default();
         let sum = |f: fn(&StationRecord) -> f64| records.iter().map(f).sum::<f64>();
         RunSummary {
             stations: records.len(),
