@@ -16,6 +16,7 @@ pub mod measurement;
 pub mod metrics;
 pub mod neighborhood;
 pub mod plot;
+pub mod recording;
 pub mod run;
 pub mod simulation;
 pub mod synth;
