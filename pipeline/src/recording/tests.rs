@@ -118,6 +118,7 @@ fn drawing(index: usize) -> RngDrawing {
 
 /// A 4096×1024 panorama like the rover's: smooth shading plus sensor-like noise, so the `.rrd`
 /// size is near a real run's.
+#[cfg(feature = "rerun")]
 fn panorama() -> image::RgbImage {
     let mut state = 0x9e37_79b9_u32;
     image::RgbImage::from_fn(4096, 1024, |x, y| {
