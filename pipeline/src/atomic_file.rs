@@ -16,19 +16,58 @@ pub fn write_via_temporary<E>(
     write: impl FnOnce(&Path) -> Result<(), E>,
     io_error: impl FnOnce(std::io::Error) -> E,
 ) -> Result<(), E> {
-    let temporary = temporary_path(path);
-    let result = write(&temporary).and_then(|()| {
-        std::fs::File::open(&temporary)
-            .and_then(|f| f.sync_all())
-            .and_then(|()| std::fs::rename(&temporary, path))
-            .map_err(io_error)
-    });
-    if result.is_err() {
-        // The temporary file may not exist (the error came before it was created); either way
-        // nothing is left behind, and the original error is the one worth reporting.
-        let _ = std::fs::remove_file(&temporary);
+    let temporary = Temporary::beside(path);
+    write(temporary.path())?;
+    temporary.commit().map_err(io_error)
+}
+
+/// The temporary file of an output written over time (a recording fed station by station):
+/// [`Temporary::commit`] moves it over its target; dropping it uncommitted removes it, so an
+/// abandoned or failed output leaves nothing behind.
+#[derive(Debug)]
+pub struct Temporary {
+    path: PathBuf,
+    target: PathBuf,
+    committed: bool,
+}
+
+impl Temporary {
+    /// Names a fresh temporary file beside `target`; nothing is created yet.
+    pub fn beside(target: &Path) -> Self {
+        Self {
+            path: temporary_path(target),
+            target: target.to_path_buf(),
+            committed: false,
+        }
     }
-    result
+
+    /// Where the writer should put the content.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The file this becomes.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Syncs the temporary file and renames it over the target.
+    pub fn commit(mut self) -> std::io::Result<()> {
+        std::fs::File::open(&self.path)?.sync_all()?;
+        std::fs::rename(&self.path, &self.target)?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Temporary {
+    fn drop(&mut self) {
+        if !self.committed {
+            // The file may never have been created; either way nothing is left behind, and
+            // whatever made the output fail is the error worth reporting.
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
 }
 
 /// Writes `bytes` to `path` atomically.

@@ -20,6 +20,7 @@ pub mod metrics;
 pub mod neighborhood;
 pub mod plot;
 pub mod ranging;
+pub mod recording;
 pub mod run;
 pub mod simulation;
 pub mod survey;
