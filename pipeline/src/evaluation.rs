@@ -11,7 +11,7 @@ use crate::map::{Hypergraph, LandmarkId};
 use crate::measurement::{Bearing, Panorama, RangeOrder};
 use crate::metrics::{evaluate, MapMetrics};
 use crate::neighborhood::{compare, estimate, RngComparison};
-use crate::run::{LandmarkRecord, StationRecord};
+use crate::run::{Association, LandmarkRecord, StationRecord};
 use crate::simulation::observations;
 use serde::Serialize;
 use std::collections::HashMap;
@@ -27,7 +27,10 @@ pub struct Detectable {
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Evaluation {
     pub detection: DetectionScore,
+    /// Bearings of every detection matched to a rock, and of those the run used (it sets
+    /// aside detections it doubts: possibly several rocks, slivers, pieces touching others).
     pub bearing: BearingScore,
+    pub bearing_used: BearingScore,
     pub range: RangeScore,
     pub association: AssociationScore,
     pub map: MapScore,
@@ -204,6 +207,7 @@ pub fn evaluate_run(
     // Truth rock of every (station index, detection index).
     let mut matched: HashMap<(usize, usize), u32> = HashMap::new();
     let mut bearing_errors = Vec::new();
+    let mut used_errors: Vec<(f64, f64)> = Vec::new();
     let mut cue_checks: [Vec<(bool, f64)>; 4] = Default::default();
     let mut worst_ratio: f64 = 0.0;
     let mut within = 0;
@@ -238,6 +242,9 @@ pub fn evaluate_run(
             let (bearing, range) = truth_of(id);
             let error = angle_error(d.bearing, bearing);
             bearing_errors.push(error);
+            if d.association != Association::Unused {
+                used_errors.push((error, d.bearing_uncertainty));
+            }
             if error <= d.bearing_uncertainty {
                 within += 1;
             }
@@ -295,6 +302,24 @@ pub fn evaluate_run(
             .to_degrees(),
         within_interval: ratio(within, bearing_errors.len()),
         worst_error_ratio: worst_ratio,
+    };
+    eval.bearing_used = BearingScore {
+        count: used_errors.len(),
+        median_error_deg: median(used_errors.iter().map(|e| e.0).collect()).to_degrees(),
+        worst_error_deg: used_errors
+            .iter()
+            .map(|e| e.0)
+            .fold(0.0, f64::max)
+            .to_degrees(),
+        within_interval: ratio(
+            used_errors.iter().filter(|e| e.0 <= e.1).count(),
+            used_errors.len(),
+        ),
+        worst_error_ratio: used_errors
+            .iter()
+            .filter(|e| e.1 > 0.0)
+            .map(|e| e.0 / e.1)
+            .fold(0.0, f64::max),
     };
     let cue = |checks: &Vec<(bool, f64)>| CueScore {
         count: checks.len(),

@@ -79,14 +79,16 @@ fn print_report(e: &Evaluation) {
         "  detection: precision {:.3} ({} of {}), recall {:.3} ({} of {} detectable) over {} images",
         d.precision, d.true_detections, d.detections, d.recall, d.detectable_found, d.detectable, d.images
     );
-    let b = &e.bearing;
-    println!(
-        "  bearing error: median {:.3}°, worst {:.3}°; inside its interval {:.1} % (worst error/interval {:.2})",
-        b.median_error_deg,
-        b.worst_error_deg,
-        100.0 * b.within_interval,
-        b.worst_error_ratio
-    );
+    for (name, b) in [("all", &e.bearing), ("used", &e.bearing_used)] {
+        println!(
+            "  bearing error ({name:<4}): {} bearings, median {:.3}°, worst {:.3}°; inside its interval {:.1} % (worst error/interval {:.2})",
+            b.count,
+            b.median_error_deg,
+            b.worst_error_deg,
+            100.0 * b.within_interval,
+            b.worst_error_ratio
+        );
+    }
     let r = &e.range;
     for (name, c) in [
         ("ground", &r.ground),

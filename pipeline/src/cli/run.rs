@@ -4,17 +4,20 @@ use super::output::write_atomic;
 use super::rng_json;
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use image::RgbImage;
 use indicatif::{ProgressBar, ProgressStyle};
 use qrm::association::AssociationSettings;
 use qrm::calib::Calibration;
 use qrm::detection::DetectorSettings;
 use qrm::edc::Edc;
+use qrm::map::Hypergraph;
 use qrm::neighborhood::estimate;
 use qrm::plot::{spring_layout, write_rng, RngPicture};
 use qrm::ranging::SensorModel;
+use qrm::recording::{McapRecorder, Recorder, RngDrawing};
 use qrm::run::front_end::{detect_station, FrontEndResult};
 use qrm::run::{Mapper, RunSummary, StationRecord};
-use qrm::survey::Survey;
+use qrm::survey::{read_image, Survey};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -37,6 +40,42 @@ pub struct RunArgs {
     /// Do not score against truth.json even if the image directory has one.
     #[arg(long)]
     pub no_eval: bool,
+    /// Also write OUT/run.rrd for the rerun viewer (needs a build with `--features rerun`).
+    #[arg(long)]
+    pub rrd: bool,
+}
+
+/// The recorders of the run: run.mcap always, run.rrd on request.
+fn recorders(args: &RunArgs) -> Result<Vec<Box<dyn Recorder>>> {
+    let mcap: Box<dyn Recorder> = Box::new(McapRecorder::create(args.out.join("run.mcap"))?);
+    #[cfg(feature = "rerun")]
+    if args.rrd {
+        let rrd = qrm::recording::RerunRecorder::create(args.out.join("run.rrd"))?;
+        return Ok(vec![mcap, Box::new(rrd)]);
+    }
+    Ok(vec![mcap])
+}
+
+/// The RNG estimate of the map over a graph layout, for the recorders and rng.png.
+fn rng_drawing(map: &Hypergraph<Edc>) -> RngDrawing {
+    let ids = map.landmarks();
+    let rng = estimate(map).unwrap_or_default();
+    let index = |id: u32| ids.iter().position(|&l| l == id).expect("edge of the map");
+    let layout = spring_layout(
+        ids.len(),
+        &rng.edges
+            .iter()
+            .map(|e| (index(e.a), index(e.b)))
+            .collect::<Vec<_>>(),
+    );
+    RngDrawing {
+        landmarks: ids
+            .iter()
+            .zip(layout)
+            .map(|(&id, (x, y))| (id, [x, y]))
+            .collect(),
+        edges: rng.edges.iter().map(|e| (e.a, e.b, e.cost)).collect(),
+    }
 }
 
 fn bar(len: usize, what: &str) -> ProgressBar {
@@ -71,6 +110,10 @@ pub fn run(args: RunArgs) -> Result<()> {
             path.display()
         );
     }
+    #[cfg(not(feature = "rerun"))]
+    if args.rrd {
+        bail!("--rrd needs a build with the rerun feature: cargo build --release -p pipeline --features rerun");
+    }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
 
@@ -88,6 +131,9 @@ pub fn run(args: RunArgs) -> Result<()> {
     progress.finish_and_clear();
     let detect_wall = started.elapsed().as_secs_f64();
 
+    let mut recorders = recorders(&args)?;
+    let wants_panorama = recorders.iter().any(|r| r.wants_panorama());
+    let no_image = RgbImage::new(0, 0);
     let mut mapper: Mapper<Edc> = Mapper::new(
         calib,
         SensorModel::default(),
@@ -113,6 +159,22 @@ pub fn run(args: RunArgs) -> Result<()> {
         for warning in &record.warnings {
             progress.suspend(|| eprintln!("warning: {warning}"));
         }
+        let panorama = if wants_panorama {
+            let primary = survey.directory.join(&station.files[0]);
+            read_image(&primary, (calib.image.width, calib.image.height))?
+        } else {
+            no_image.clone()
+        };
+        let drawing = rng_drawing(&mapper.map);
+        for recorder in &mut recorders {
+            let image = if recorder.wants_panorama() {
+                &panorama
+            } else {
+                &no_image
+            };
+            recorder.station(&record, image)?;
+            recorder.rng(record.index, &drawing)?;
+        }
         records.push(record);
     }
     progress.finish_and_clear();
@@ -126,6 +188,9 @@ pub fn run(args: RunArgs) -> Result<()> {
     let map_wall = map_started.elapsed().as_secs_f64();
 
     write_outputs(&args.out, &mapper, &records)?;
+    for recorder in recorders {
+        recorder.finish()?;
+    }
     let summary = RunSummary::of(&records, &mapper, skipped.len(), detect_wall, map_wall);
     write_atomic(
         &args.out.join("summary.json"),
@@ -161,27 +226,31 @@ fn write_outputs(out: &Path, mapper: &Mapper<Edc>, records: &[StationRecord]) ->
         &out.join("rng.json"),
         rng_json(&mapper.map, &rng).as_bytes(),
     )?;
-    let ids = mapper.map.landmarks();
-    let index = |id: u32| ids.iter().position(|&l| l == id).expect("edge of the map");
-    let edges: Vec<(usize, usize, f64)> = rng
-        .edges
-        .iter()
-        .map(|e| (index(e.a), index(e.b), e.cost))
-        .collect();
-    if !ids.is_empty() {
-        let layout = spring_layout(
-            ids.len(),
-            &edges.iter().map(|e| (e.0, e.1)).collect::<Vec<_>>(),
-        );
+    let drawing = rng_drawing(&mapper.map);
+    if !drawing.landmarks.is_empty() {
+        let index = |id: u32| {
+            drawing
+                .landmarks
+                .iter()
+                .position(|l| l.0 == id)
+                .expect("edge of the map")
+        };
+        let positions: Vec<(f64, f64)> =
+            drawing.landmarks.iter().map(|l| (l.1[0], l.1[1])).collect();
+        let edges: Vec<(usize, usize, f64)> = drawing
+            .edges
+            .iter()
+            .map(|&(a, b, cost)| (index(a), index(b), cost))
+            .collect();
         write_rng(
             &out.join("rng.png"),
             &RngPicture {
                 title: format!(
                     "RNG after {} stations ({} landmarks; graph layout, not metric)",
                     records.len(),
-                    ids.len()
+                    positions.len()
                 ),
-                landmarks: &layout,
+                landmarks: &positions,
                 edges: &edges,
                 true_edges: &[],
                 stations: &[],

@@ -239,6 +239,10 @@ impl McapRecorder {
 }
 
 impl Recorder for McapRecorder {
+    fn wants_panorama(&self) -> bool {
+        false
+    }
+
     fn station(
         &mut self,
         record: &StationRecord,

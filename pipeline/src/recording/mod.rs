@@ -21,7 +21,12 @@ pub use rerun_recorder::RerunRecorder;
 
 /// What `pipeline run` feeds each output as the stations go by.
 pub trait Recorder {
-    /// After each station: its record and its primary panorama (left or mono image).
+    /// Whether [`Recorder::station`] uses the panorama (the run decodes it again only then).
+    fn wants_panorama(&self) -> bool {
+        true
+    }
+    /// After each station: its record and its primary panorama (left or mono image; an empty
+    /// image for a recorder that does not want it).
     fn station(
         &mut self,
         record: &StationRecord,
