@@ -153,14 +153,19 @@ pub fn associate<C: Calculus>(
                 i,
                 &candidates[i],
                 &anchored,
-                &recent,
                 &|l| {
                     // Candidates of a registered frame were kept only if they lie where the
                     // motion puts the detection: placement confirms them.
-                    registrations
+                    let registered = registrations
                         .iter()
-                        .any(|(frame, _)| frame.landmarks.iter().any(|m| m.0 == l))
-                        && placed[i].is_some()
+                        .any(|(frame, _)| frame.landmarks.iter().any(|m| m.0 == l));
+                    if registered && placed[i].is_some() {
+                        Standing::Placed
+                    } else if recent(l) {
+                        Standing::Recent
+                    } else {
+                        Standing::Old
+                    }
                 },
                 settings,
             ),
@@ -202,8 +207,7 @@ pub fn reconsider<C: Calculus>(
         detection,
         &open,
         decided,
-        &|_| true,
-        &|_| false,
+        &|_| Standing::Recent,
         settings,
     )
 }
@@ -293,6 +297,17 @@ fn drop_inconsistent_anchors<C: Calculus>(
     }
 }
 
+/// What the run knows about a candidate landmark's whereabouts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Standing {
+    /// In a registered recent station, where the motion puts the detection.
+    Placed,
+    /// Seen at a recent station.
+    Recent,
+    /// Not seen lately.
+    Old,
+}
+
 /// 000 §VI-C for one detection: candidates inconsistent with the map are rejected.
 fn decide<C: Calculus>(
     map: &Hypergraph<C>,
@@ -300,8 +315,7 @@ fn decide<C: Calculus>(
     detection: usize,
     candidates: &[(LandmarkId, f64)],
     anchors: &[(usize, LandmarkId)],
-    recent: &dyn Fn(LandmarkId) -> bool,
-    placed_near: &dyn Fn(LandmarkId) -> bool,
+    standing: &dyn Fn(LandmarkId) -> Standing,
     settings: &AssociationSettings,
 ) -> Decision {
     let taken = |l: LandmarkId| anchors.iter().any(|a| a.1 == l);
@@ -312,7 +326,8 @@ fn decide<C: Calculus>(
             // constrains: otherwise every unknown rock would be held back for every old
             // look-alike, and the map would stop growing.
             Some(informative)
-                if recent(landmark) || informative >= settings.informative_triples =>
+                if standing(landmark) != Standing::Old
+                    || informative >= settings.informative_triples =>
             {
                 survivors.push((landmark, informative))
             }
@@ -322,7 +337,8 @@ fn decide<C: Calculus>(
     match survivors.as_slice() {
         [] => Decision::New,
         [(landmark, informative)]
-            if *informative >= settings.informative_triples || placed_near(*landmark) =>
+            if *informative >= settings.informative_triples
+                || standing(*landmark) == Standing::Placed =>
         {
             Decision::Matched(*landmark)
         }

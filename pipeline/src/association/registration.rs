@@ -157,6 +157,9 @@ fn same_assignment(a: &[(usize, usize)], b: &[(usize, usize)]) -> bool {
     2 * shared >= a.len().min(b.len())
 }
 
+/// A point of the current station and its partner in the frame.
+type PointPair = ([f64; 2], [f64; 2]);
+
 /// Rotation by `angle` then translation.
 struct Motion {
     cos: f64,
@@ -179,9 +182,9 @@ impl Motion {
     }
 
     /// The least-squares rigid motion taking each `.0` onto its `.1` (2-D Procrustes).
-    fn fit(pairs: &[([f64; 2], [f64; 2])]) -> Motion {
+    fn fit(pairs: &[PointPair]) -> Motion {
         let n = pairs.len() as f64;
-        let mean = |f: fn(&([f64; 2], [f64; 2])) -> [f64; 2]| {
+        let mean = |f: fn(&PointPair) -> [f64; 2]| {
             let sum = pairs
                 .iter()
                 .map(f)
