@@ -88,7 +88,10 @@ fn maps_the_demo_dataset_soundly() {
     assert_eq!(score(&["range", "wrong_pairs"]), 0.0, "{eval}");
     assert_eq!(score(&["map", "run", "unsound_relations"]), 0.0, "{eval}");
     assert_eq!(score(&["map", "exact", "unsound_relations"]), 0.0, "{eval}");
-    assert!(score(&["bearing_used", "within_interval"]) >= 0.95, "{eval}");
+    assert!(
+        score(&["bearing_used", "within_interval"]) >= 0.95,
+        "{eval}"
+    );
     assert!(score(&["association", "accuracy"]) >= 0.9, "{eval}");
     assert!(score(&["detection", "recall"]) >= 0.7, "{eval}");
     assert!(

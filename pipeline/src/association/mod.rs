@@ -30,6 +30,9 @@ use crate::ranging::RangeInterval;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+/// Closest look-alike landmarks per detection that seed registration hypotheses.
+const REGISTRATION_SEEDS: usize = 6;
+
 /// Slack of the placement test against a registered frame, metres: generous, since ruling
 /// out the true landmark would make a duplicate.
 const PLACEMENT_SLACK_M: f64 = 1.0;
@@ -95,10 +98,18 @@ pub fn associate<C: Calculus>(
         .map(|e| proposals(e, gallery, settings))
         .collect();
     let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
+    // Registration hypotheses grow with the square of the seeds: each detection seeds only
+    // with its closest few look-alikes (the lists are sorted by descriptor distance).
+    let seed = |i: usize, l: LandmarkId| {
+        candidates[i]
+            .iter()
+            .take(REGISTRATION_SEEDS)
+            .any(|c| c.0 == l)
+    };
     let recent = |l: LandmarkId| frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
     let registrations: Vec<(&Frame, Registration)> = frames
         .iter()
-        .filter_map(|frame| Some((frame, register(placed, frame, &alike)?)))
+        .filter_map(|frame| Some((frame, register(placed, frame, &alike, &seed)?)))
         .collect();
     // Registered correspondences of all frames; a detection or landmark given two different
     // partners by different frames is left out.

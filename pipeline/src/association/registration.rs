@@ -42,23 +42,31 @@ pub const MIN_INLIERS: usize = 4;
 
 /// The rigid motion from the current station (`current`, by detection) to `frame` explaining
 /// most look-alike correspondences (`alike(detection, landmark)`), if it explains at least
-/// [`MIN_INLIERS`] and clearly more than any motion that differs from it.
+/// [`MIN_INLIERS`] and clearly more than any motion that differs from it. Motions are
+/// hypothesised only from pairs of the closest look-alikes (`seed`), which keeps the search
+/// quadratic in the detections rather than in all look-alike pairs.
 pub fn register(
     current: &[Option<Placed>],
     frame: &Frame,
     alike: &dyn Fn(usize, LandmarkId) -> bool,
+    seed: &dyn Fn(usize, LandmarkId) -> bool,
 ) -> Option<Registration> {
     let correspondences: Vec<(usize, usize)> = (0..current.len())
         .filter(|&i| current[i].is_some())
         .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
         .filter(|&(i, j)| alike(i, frame.landmarks[j].0))
         .collect();
+    let seeds: Vec<(usize, usize)> = correspondences
+        .iter()
+        .copied()
+        .filter(|&(i, j)| seed(i, frame.landmarks[j].0))
+        .collect();
     // Hypotheses scored by how tightly they fit: Σ (1 − (d / tolerance)²) over their
     // correspondences, so that a loose fit of many does not beat a tight fit of nearly as many.
     let mut best: Option<(f64, Vec<(usize, usize)>)> = None;
     let mut runner_up: f64 = 0.0;
-    for (x, &(i1, j1)) in correspondences.iter().enumerate() {
-        for &(i2, j2) in &correspondences[x + 1..] {
+    for (x, &(i1, j1)) in seeds.iter().enumerate() {
+        for &(i2, j2) in &seeds[x + 1..] {
             if i1 == i2 || j1 == j2 {
                 continue;
             }
@@ -298,7 +306,8 @@ mod tests {
                 })
             })
             .collect();
-        let registration = register(&current, &frame, &|_, _| true).expect("registers");
+        let registration =
+            register(&current, &frame, &|_, _| true, &|_, _| true).expect("registers");
         let mut pairs = registration.pairs.clone();
         pairs.sort_unstable();
         let expected: Vec<(usize, LandmarkId)> = order
@@ -324,6 +333,6 @@ mod tests {
             point: [1.0, 1.0],
             radius: 0.1,
         })];
-        assert_eq!(register(&current, &frame, &|_, _| true), None);
+        assert_eq!(register(&current, &frame, &|_, _| true, &|_, _| true), None);
     }
 }
