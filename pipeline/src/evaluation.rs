@@ -80,6 +80,13 @@ pub struct RangeScore {
     pub pairs: usize,
     pub asserted_pairs: usize,
     pub wrong_pairs: usize,
+    /// All asserted pairs (matched to truth or not), those each cue separates on its own, and
+    /// those only the fused intervals separate.
+    pub asserted_all: usize,
+    pub separated_by_ground: usize,
+    pub separated_by_stereo: usize,
+    pub separated_by_size: usize,
+    pub separated_only_fused: usize,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -281,6 +288,20 @@ pub fn evaluate_run(
             }
         }
         for &(i, j) in &record.order {
+            let (a, b) = (&record.detections[i].range, &record.detections[j].range);
+            let apart = |x: Option<[f64; 2]>, y: Option<[f64; 2]>| {
+                matches!((x, y), (Some(x), Some(y)) if x[1] < y[0])
+            };
+            let by = [
+                apart(a.ground, b.ground),
+                apart(a.stereo, b.stereo),
+                apart(a.size, b.size),
+            ];
+            eval.range.asserted_all += 1;
+            eval.range.separated_by_ground += usize::from(by[0]);
+            eval.range.separated_by_stereo += usize::from(by[1]);
+            eval.range.separated_by_size += usize::from(by[2]);
+            eval.range.separated_only_fused += usize::from(!by.iter().any(|&x| x));
             if let (Some(Some(ri)), Some(Some(rj))) = (ranges.get(i), ranges.get(j)) {
                 eval.range.asserted_pairs += 1;
                 if ri > rj {

@@ -107,6 +107,11 @@ fn print_report(e: &Evaluation) {
         "  range order: {} of {} pairs asserted, {} wrong; {} cue conflicts",
         r.asserted_pairs, r.pairs, r.wrong_pairs, r.conflicts
     );
+    println!(
+        "  of all {} asserted pairs, separated by ground alone {}, stereo alone {}, size alone {}, only by the fusion {}",
+        r.asserted_all,
+        r.separated_by_ground, r.separated_by_stereo, r.separated_by_size, r.separated_only_fused
+    );
     let a = &e.association;
     println!(
         "  association: accuracy {:.3} ({} of {} sightings), {} landmarks, {} rocks duplicated, {} landmarks mixed, {} sightings of false detections",
