@@ -289,9 +289,7 @@ pub fn evaluate_run(
         }
         for &(i, j) in &record.order {
             let (a, b) = (&record.detections[i].range, &record.detections[j].range);
-            let apart = |x: Option<[f64; 2]>, y: Option<[f64; 2]>| {
-                matches!((x, y), (Some(x), Some(y)) if x[1] < y[0])
-            };
+            let apart = |x: Option<[f64; 2]>, y: Option<[f64; 2]>| matches!((x, y), (Some(x), Some(y)) if x[1] < y[0]);
             let by = [
                 apart(a.ground, b.ground),
                 apart(a.stereo, b.stereo),
