@@ -191,6 +191,62 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// Checks that `truth`, `records` and `landmarks` (read from files) refer to each other
+/// consistently, so that scoring can index them: every image's station and rock exist, every
+/// order pair and sighting names an existing detection.
+pub fn check_files(
+    truth: &Truth,
+    records: &[StationRecord],
+    landmarks: &[LandmarkRecord],
+) -> Result<(), String> {
+    for image in &truth.images {
+        if image.station >= truth.stations.len() {
+            return Err(format!(
+                "image {} names station {} of {}",
+                image.file,
+                image.station,
+                truth.stations.len()
+            ));
+        }
+        if let Some(rock) = image
+            .rocks
+            .iter()
+            .find(|r| r.id as usize >= truth.rocks.len())
+        {
+            return Err(format!(
+                "image {} shows rock {} of {}",
+                image.file,
+                rock.id,
+                truth.rocks.len()
+            ));
+        }
+    }
+    for record in records {
+        let n = record.detections.len();
+        if let Some(&(i, j)) = record.order.iter().find(|&&(i, j)| i >= n || j >= n) {
+            return Err(format!(
+                "station {} orders detections ({i}, {j}) of {n}",
+                record.station
+            ));
+        }
+    }
+    for landmark in landmarks {
+        for &(station, detection) in &landmark.sightings {
+            let exists = records
+                .iter()
+                .find(|r| r.index == station)
+                .is_some_and(|r| detection < r.detections.len());
+            if !exists {
+                return Err(format!(
+                    "landmark {} was sighted at station {station}, detection {detection}, which the run does not have",
+                    landmark.landmark
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Everything `evaluate_run` needs, read by the caller.
 pub struct RunFiles<'a> {
     pub records: &'a [StationRecord],

@@ -192,6 +192,10 @@ fn a_bad_image_is_skipped_with_a_warning() {
         .save(dir.join("station_003_left.png"))
         .unwrap();
     std::fs::remove_file(dir.join("station_003_right.png")).unwrap();
+    // A mono JPEG panorama is read (and, blank, has no rocks).
+    image::RgbImage::from_pixel(1024, 192, image::Rgb([150, 110, 80]))
+        .save(dir.join("blank.jpg"))
+        .unwrap();
     let out = scratch("bad-images-out");
     let o = pipeline(&[
         "run",
@@ -216,6 +220,6 @@ fn a_bad_image_is_skipped_with_a_warning() {
         "{err}"
     );
     let summary = json(&out.join("summary.json"));
-    assert_eq!(summary["stations"], 4);
+    assert_eq!(summary["stations"], 5);
     assert_eq!(summary["stations_skipped"], 1);
 }

@@ -20,7 +20,7 @@ mod gallery;
 mod registration;
 
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
-pub use registration::{register, Frame, Placed, Registration, MIN_INLIERS};
+pub use registration::{register, Frame, Placed, Registration};
 
 use crate::calculus::Calculus;
 use crate::detection::Appearance;
@@ -182,14 +182,14 @@ pub fn associate<C: Calculus>(
             ),
         })
         .collect();
-    // Two detections may not be one landmark: hold both back.
-    for i in 0..n {
-        if let Decision::Matched(l) = decisions[i] {
-            let clash: Vec<usize> = (0..n)
-                .filter(|&j| j != i && decisions[j] == Decision::Matched(l))
-                .collect();
-            if !clash.is_empty() && !anchored.iter().any(|a| a.0 == i) {
-                decisions[i] = Decision::HeldBack(vec![l]);
+    // Two detections may not be one landmark: hold all claimants back (anchors never clash:
+    // their landmarks are taken out of the other detections' candidates).
+    let claims = decisions.clone();
+    for (i, decision) in decisions.iter_mut().enumerate() {
+        if let Decision::Matched(l) = claims[i] {
+            let clash = (0..n).any(|j| j != i && claims[j] == Decision::Matched(l));
+            if clash {
+                *decision = Decision::HeldBack(vec![l]);
             }
         }
     }

@@ -38,7 +38,7 @@ const UNIQUE: f64 = 2.0;
 /// How much better (in fit score) the best motion must be than any different one.
 const MARGIN: f64 = 1.5;
 /// Fewest correspondences a registration must explain to be believed.
-pub const MIN_INLIERS: usize = 4;
+const MIN_INLIERS: usize = 4;
 
 /// The rigid motion from the current station (`current`, by detection) to `frame` explaining
 /// most look-alike correspondences (`alike(detection, landmark)`), if it explains at least

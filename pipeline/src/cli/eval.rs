@@ -1,8 +1,8 @@
 //! `pipeline eval --run OUT --truth truth.json`: scores a run against the renderer's truth
-//! (docs/RUN.md): eval.json, a printed report, and the RNG drawn at the true positions.
+//! (docs/RUN.md): eval.json and a printed report.
 
 use super::output::write_atomic;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use qrm::calib::Calibration;
 use qrm::dataset::Truth;
@@ -21,6 +21,9 @@ pub struct EvalArgs {
     /// The dataset's truth.json.
     #[arg(long)]
     pub truth: PathBuf,
+    /// The calibration the run used (default: calib.toml beside the truth file).
+    #[arg(long)]
+    pub calib: Option<PathBuf>,
     /// Where eval.json goes (default: the run directory).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -28,7 +31,12 @@ pub struct EvalArgs {
 
 pub fn run(args: EvalArgs) -> Result<()> {
     let out = args.out.clone().unwrap_or_else(|| args.run.clone());
-    evaluate_run(&args.run, &args.truth, &out)
+    let calib_path = args
+        .calib
+        .clone()
+        .unwrap_or_else(|| args.truth.with_file_name("calib.toml"));
+    let calib = Calibration::load(&calib_path)?;
+    evaluate_run(&args.run, &args.truth, &calib, &out)
 }
 
 fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
@@ -39,7 +47,12 @@ fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
 }
 
 /// Scores the run in `run_dir` against `truth_path`, writing `eval.json` into `out`.
-pub fn evaluate_run(run_dir: &Path, truth_path: &Path, out: &Path) -> Result<()> {
+pub fn evaluate_run(
+    run_dir: &Path,
+    truth_path: &Path,
+    calib: &Calibration,
+    out: &Path,
+) -> Result<()> {
     let truth: Truth = read(truth_path)?;
     let records: Vec<StationRecord> = read(&run_dir.join("stations.json"))?;
     let landmarks: Vec<LandmarkRecord> = read(&run_dir.join("landmarks.json"))?;
@@ -48,8 +61,13 @@ pub fn evaluate_run(run_dir: &Path, truth_path: &Path, out: &Path) -> Result<()>
         .with_context(|| format!("cannot read {}", map_path.display()))?;
     let map = Hypergraph::<Edc>::from_json(&map_text)
         .with_context(|| format!("{}", map_path.display()))?;
-    let calib_path = truth_path.with_file_name("calib.toml");
-    let calib = Calibration::load(&calib_path)?;
+    if let Err(problem) = evaluation::check_files(&truth, &records, &landmarks) {
+        bail!(
+            "{} does not fit the run in {}: {problem}",
+            truth_path.display(),
+            run_dir.display()
+        );
+    }
     let settings = DetectorSettings::default();
     let eval = evaluation::evaluate_run(
         &RunFiles {
@@ -58,7 +76,7 @@ pub fn evaluate_run(run_dir: &Path, truth_path: &Path, out: &Path) -> Result<()>
             map: &map,
         },
         &truth,
-        &calib,
+        calib,
         Detectable {
             min_width_m: settings.min_width_m,
             max_range_m: settings.max_range_m,

@@ -114,8 +114,6 @@ pub fn run(args: RunArgs) -> Result<()> {
     if args.rrd {
         bail!("--rrd needs a build with the rerun feature: cargo build --release -p pipeline --features rerun");
     }
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
 
     let detector = DetectorSettings::default();
     let progress = bar(survey.stations.len(), "detect");
@@ -131,6 +129,20 @@ pub fn run(args: RunArgs) -> Result<()> {
     progress.finish_and_clear();
     let detect_wall = started.elapsed().as_secs_f64();
 
+    if front.iter().all(|r| r.station.is_err()) {
+        for result in &front {
+            if let Err(warning) = &result.station {
+                eprintln!("warning: {warning}");
+            }
+        }
+        bail!(
+            "none of the {} stations in {} could be read; nothing was written",
+            survey.stations.len(),
+            survey.directory.display()
+        );
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
     let mut recorders = recorders(&args)?;
     let wants_panorama = recorders.iter().any(|r| r.wants_panorama());
     let no_image = RgbImage::new(0, 0);
@@ -178,13 +190,6 @@ pub fn run(args: RunArgs) -> Result<()> {
         records.push(record);
     }
     progress.finish_and_clear();
-    if records.is_empty() {
-        bail!(
-            "none of the {} stations in {} could be read; nothing was written",
-            survey.stations.len(),
-            survey.directory.display()
-        );
-    }
     let map_wall = map_started.elapsed().as_secs_f64();
 
     write_outputs(&args.out, &mapper, &records)?;
@@ -212,10 +217,22 @@ pub fn run(args: RunArgs) -> Result<()> {
         let default = args.images.join("truth.json");
         default.exists().then_some(default)
     });
-    if let (Some(truth), false) = (truth, args.no_eval) {
-        super::eval::evaluate_run(&args.out, &truth, &args.out)?;
+    match (truth, args.no_eval) {
+        (Some(truth), false) => super::eval::evaluate_run(&args.out, &truth, &calib, &args.out)?,
+        // A scoring left from an earlier run into the same directory would not be this run's.
+        _ => remove_stale(&args.out.join("eval.json"))?,
     }
     Ok(())
+}
+
+/// Removes an output of an earlier run into the same directory that this run does not write.
+fn remove_stale(path: &Path) -> Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(e).with_context(|| format!("cannot remove the stale {}", path.display()))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// map.json, rng.json, rng.png, stations.json, landmarks.json.
@@ -256,6 +273,8 @@ fn write_outputs(out: &Path, mapper: &Mapper<Edc>, records: &[StationRecord]) ->
                 stations: &[],
             },
         )?;
+    } else {
+        remove_stale(&out.join("rng.png"))?;
     }
     write_atomic(
         &out.join("stations.json"),

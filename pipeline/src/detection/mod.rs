@@ -249,8 +249,9 @@ fn along_columns(input: &[u8], out: &mut [u8], w: usize, f: fn(u8, u8) -> u8) {
     }
 }
 
-/// The detection of `blob` (band rows offset by `top`), or `None` if it is narrower than
-/// `min_width_m` or farther than `max_range_m`.
+/// The detection of `blob` (band rows offset by `top`), or `None` if it is empty, its contact
+/// row is at or above the horizon, or it is narrower than `min_width_m` or farther than
+/// `max_range_m`.
 fn accept(
     blob: Blob,
     ambiguous: bool,
@@ -258,6 +259,9 @@ fn accept(
     calib: &Calibration,
     settings: &DetectorSettings,
 ) -> Option<Detection> {
+    if blob.pixels == 0 || blob.col_max < blob.col_min {
+        return None;
+    }
     let n = f64::from(blob.pixels);
     let contact_row = (blob.row_max + top + 1) as f64;
     let range = calib.ground_range(contact_row)?;

@@ -17,7 +17,9 @@ use crate::geometry::{boundary_values, Coordinate, Point2};
 use std::f64::consts::FRAC_PI_2;
 use std::ops::{Add, Sub};
 
-/// Halvings of the range box: the smallest boxes are 2⁻¹⁰ wide in each range.
+/// Halvings of the range box: the smallest boxes are 2⁻⁷ wide in each range. Deeper boxes
+/// (2⁻¹⁰) doubled the mapping time of `pipeline run` on real bearing intervals; shallower ones
+/// keep more regions, never fewer than the truth needs.
 pub const MAX_DEPTH: u32 = 14;
 
 /// A closed interval of reals.

@@ -1,7 +1,7 @@
 //! A drawing position for each landmark when no metric positions exist: the qualitative map
 //! has none, so `pipeline run` draws the RNG as a graph, placed by a force-directed layout
 //! (Fruchterman–Reingold): edges pull their ends together, all landmarks push apart. The
-//! picture shows the graph's structure, not distances; `pipeline eval` draws at ground truth.
+//! picture shows the graph's structure, not distances.
 
 use std::f64::consts::TAU;
 

@@ -26,8 +26,8 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 
 /// The error bounds of the vision front end: every interval it produces is widened by these.
-/// The defaults are calibrated on the synthetic presets with a margin (`docs/RUN.md` gives the
-/// measured worst cases they cover).
+/// The defaults are calibrated on the synthetic presets (`docs/RUN.md`, "Figures", gives how
+/// often the measured errors stay inside them).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SensorModel {
     /// Bearing error of a centroid: `px + per_width × apparent width`, in columns. The
@@ -42,7 +42,9 @@ pub struct SensorModel {
     /// Error of a left–right azimuth difference: `px + per_width × apparent width`, columns.
     pub disparity_error_px: f64,
     pub disparity_error_per_width: f64,
-    /// Factor by which a rock's apparent width may change between viewpoints.
+    /// Factor by which a rock's apparent width may differ from its reference width at any
+    /// viewpoint: applied when a view bounds the reference width and again when the reference
+    /// bounds another view's range, so two views may differ by its square.
     pub size_change: f64,
     /// Nearest range at which rocks are looked for in the right panorama, metres.
     pub min_range_m: f64,

@@ -18,6 +18,12 @@ pub fn match_stereo(
     calib: &Calibration,
     model: &SensorModel,
 ) -> Vec<Option<usize>> {
+    // A right detection the detector doubts, or one touching another, may be several rocks or
+    // part of one: its centroid would corrupt both the range and the bearing.
+    let width = calib.image.width;
+    let trusted: Vec<bool> = (0..right.len())
+        .map(|j| !right[j].ambiguous && !super::touches_neighbour(j, right, width))
+        .collect();
     let cost: Vec<Vec<Option<f64>>> = left
         .iter()
         .map(|l| {
@@ -31,8 +37,10 @@ pub fn match_stereo(
     let best_left = |j: usize| best_of(cost.iter().map(|row| row[j]).enumerate());
     (0..left.len())
         .map(|i| {
+            // The best partner, if it is a doubtful detection, gives no cue: falling back to
+            // the runner-up would pair the rock with a neighbour.
             let (j, _) = best_right(i)?;
-            (best_left(j).map(|(k, _)| k) == Some(i)).then_some(j)
+            (trusted[j] && best_left(j).map(|(k, _)| k) == Some(i)).then_some(j)
         })
         .collect()
 }

@@ -152,6 +152,7 @@ impl<C: Calculus> Mapper<C> {
                 station.name,
                 usable.len()
             ));
+            record.fusion.resolved_held_back = self.retry_held_back(&mut record);
             record.metrics = self.metrics();
             return record;
         }
@@ -209,6 +210,8 @@ impl<C: Calculus> Mapper<C> {
             .collect();
         let fused_positions: Vec<usize> = fused.iter().map(|f| f.0).collect();
         let ids: Vec<LandmarkId> = fused.iter().map(|f| f.1).collect();
+        // With fewer than three landmarks there is no triple to measure, but the sightings
+        // still place and describe the landmarks for association at later stations.
         let sub = sub_panorama(&panorama, &fused_positions);
         let batch = if ids.len() >= 3 {
             observations(&self.map, &ids, &sub)
@@ -276,14 +279,17 @@ impl<C: Calculus> Mapper<C> {
     /// Tries every held-back observation against the current map; returns how many were
     /// resolved and fused.
     fn retry_held_back(&mut self, record: &mut StationRecord) -> usize {
-        let mut resolved = 0;
-        let mut still = Vec::new();
         let current = record.index;
-        for mut item in std::mem::take(&mut self.held) {
-            if current > item.station + HOLD_STATIONS {
-                self.expired += 1;
-                continue;
-            }
+        let mut pending = std::mem::take(&mut self.held);
+        let before = pending.len();
+        // Observations that waited long enough, or have too few fused partners at their
+        // station to be measured with, are given up.
+        pending.retain(|item| current <= item.station + HOLD_STATIONS && item.decided.len() >= 2);
+        self.expired += before - pending.len();
+        let mut resolved = 0;
+        let mut done = vec![false; pending.len()];
+        for k in 0..pending.len() {
+            let item = &pending[k];
             let decision = reconsider(
                 &self.map,
                 &item.panorama,
@@ -296,12 +302,12 @@ impl<C: Calculus> Mapper<C> {
                 Decision::Matched(l) => l,
                 Decision::New => self.next_landmark,
                 Decision::HeldBack(candidates) => {
-                    item.candidates = candidates;
-                    still.push(item);
+                    pending[k].candidates = candidates;
                     continue;
                 }
             };
-            let batch = focused_observations(&self.map, &item, landmark);
+            done[k] = true;
+            let batch = focused_observations(&self.map, item, landmark);
             match self.map.fuse(&batch) {
                 Ok(_) => {
                     if landmark == self.next_landmark {
@@ -315,6 +321,15 @@ impl<C: Calculus> Mapper<C> {
                     self.sightings
                         .push((item.station, item.primary_index, landmark));
                     resolved += 1;
+                    // The station's other held observations now know this detection's
+                    // landmark: a partner to measure with, and no longer a candidate.
+                    let (station, detection) = (item.station, item.detection);
+                    for other in pending.iter_mut().filter(|o| o.station == station) {
+                        if other.detection != detection {
+                            other.decided.push((detection, landmark));
+                            other.candidates.retain(|&c| c != landmark);
+                        }
+                    }
                 }
                 Err(contradiction) => record.warnings.push(format!(
                     "held-back observation of station {} dropped: {contradiction}",
@@ -322,7 +337,12 @@ impl<C: Calculus> Mapper<C> {
                 )),
             }
         }
-        self.held = still;
+        self.held = pending
+            .into_iter()
+            .zip(done)
+            .filter(|(_, d)| !d)
+            .map(|(item, _)| item)
+            .collect();
         resolved
     }
 

@@ -22,6 +22,8 @@ pub struct RunSummary {
     pub held_back: usize,
     pub resolved_held_back: usize,
     pub pending_held_back: usize,
+    /// Held back and given up (waited too long, or their station had too few fused partners).
+    pub expired_held_back: usize,
     pub rng_certain: usize,
     pub rng_uncertain: usize,
     /// Seconds per stage, summed over stations (decode and detect run on all cores).
@@ -67,6 +69,7 @@ impl RunSummary {
                 .count(),
             resolved_held_back: records.iter().map(|r| r.fusion.resolved_held_back).sum(),
             pending_held_back: mapper.held_back(),
+            expired_held_back: mapper.expired,
             rng_certain: last.rng_certain,
             rng_uncertain: last.rng_uncertain,
             seconds_decode: sum(|r| r.seconds.decode),
@@ -97,8 +100,12 @@ impl fmt::Display for RunSummary {
         )?;
         writeln!(
             f,
-            "contradictions: {}; held back: {} ({} resolved later, {} pending)",
-            self.contradictions, self.held_back, self.resolved_held_back, self.pending_held_back
+            "contradictions: {}; held back: {} ({} resolved later, {} given up, {} pending)",
+            self.contradictions,
+            self.held_back,
+            self.resolved_held_back,
+            self.expired_held_back,
+            self.pending_held_back
         )?;
         write!(
             f,
