@@ -78,7 +78,8 @@ fn maps_the_demo_dataset_soundly() {
     assert!(summary["landmarks"].as_u64().unwrap() >= 10, "{summary}");
     let eval = json(&out.join("eval.json"));
     // Soundness: no asserted order is wrong, no true state removed; the bearings the run used
-    // hold the truth within their intervals but for rare detector failures (docs/RUN.md).
+    // hold the truth within their intervals but for rare detector failures (docs/RUN.md,
+    // "Figures").
     let score = |path: &[&str]| {
         path.iter()
             .fold(&eval, |v, k| &v[*k])
