@@ -374,8 +374,9 @@ const MIN_COLUMNS: u32 = 3;
 const RECENT_FRAMES: usize = 6;
 
 /// Stations a held-back observation waits for the map to tighten before it is given up (an
-/// observation not fused loses information, never soundness).
-const HOLD_STATIONS: usize = 2;
+/// observation not fused loses information, never soundness). One: on the presets no
+/// observation resolved at a second retry, and every retry measures again.
+const HOLD_STATIONS: usize = 1;
 
 /// A detection's rough position around the station, if its range is bounded well enough to
 /// place it: the middle of its range interval along its bearing.
