@@ -207,10 +207,13 @@ pub fn run(args: RunArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         args.out.display()
     );
+    if args.out.join("rng.png").exists() {
+        println!("  look at {} (the RNG)", args.out.join("rng.png").display());
+    }
     println!(
-        "  look at {} (the RNG) and {} (the map, docs/MAP_FORMAT.md)",
-        args.out.join("rng.png").display(),
-        args.out.join("map.json").display()
+        "  the map is {} (docs/MAP_FORMAT.md); everything per station is in {} (docs/RUN_OUTPUTS.md)",
+        args.out.join("map.json").display(),
+        args.out.join("run.mcap").display()
     );
 
     let truth = args.truth.clone().or_else(|| {
