@@ -9,7 +9,7 @@ use crate::edc::Edc;
 use crate::geometry::Point;
 use crate::map::{Hypergraph, LandmarkId};
 use crate::measurement::{Bearing, Panorama, RangeOrder};
-use crate::metrics::{evaluate, MapMetrics};
+use crate::metrics::evaluate;
 use crate::neighborhood::{compare, estimate, RngComparison};
 use crate::run::{Association, LandmarkRecord, StationRecord};
 use crate::simulation::observations;
@@ -119,6 +119,9 @@ pub struct MapMetricsScore {
     pub fully_constrained_pct: f64,
     /// Relations whose true state was removed (target 0).
     pub unsound_relations: usize,
+    /// Landmarks in unsound relations, with how many each is in, most first: where to look
+    /// for a wrong association or a bad measurement.
+    pub unsound_landmarks: Vec<(LandmarkId, usize)>,
     pub undefined_triples: usize,
 }
 
@@ -452,9 +455,9 @@ pub fn evaluate_run(
     let truth_fn = |a: LandmarkId, b: LandmarkId, c: LandmarkId| {
         Edc::classify(position(a)?, position(b)?, position(c)?)
     };
-    eval.map.run = map_score(run.map, evaluate(run.map, truth_fn, run.map.len()));
+    eval.map.run = map_score(run.map, &truth_fn);
     let exact = exact_map(run, truth, &defined);
-    eval.map.exact = map_score(&exact, evaluate(&exact, truth_fn, exact.len()));
+    eval.map.exact = map_score(&exact, &truth_fn);
     eval.map.rng = estimate(run.map).and_then(|rng| {
         let ids = run.map.landmarks();
         if ids.iter().any(|&l| position(l).is_none()) {
@@ -531,8 +534,25 @@ fn exact_map(
     map
 }
 
-fn map_score<C: Calculus>(map: &Hypergraph<C>, m: MapMetrics) -> MapMetricsScore {
+fn map_score<C: Calculus>(
+    map: &Hypergraph<C>,
+    truth: &impl Fn(LandmarkId, LandmarkId, LandmarkId) -> Option<u8>,
+) -> MapMetricsScore {
+    let m = evaluate(map, truth, map.len());
+    let mut unsound: HashMap<LandmarkId, usize> = HashMap::new();
+    for (a, b, c, relations) in map.triples() {
+        for (set, (x, y, z)) in relations.iter().zip([(a, b, c), (b, c, a), (c, a, b)]) {
+            if truth(x, y, z).is_some_and(|t| !set.contains(t)) {
+                for l in [x, y, z] {
+                    *unsound.entry(l).or_default() += 1;
+                }
+            }
+        }
+    }
+    let mut unsound_landmarks: Vec<(LandmarkId, usize)> = unsound.into_iter().collect();
+    unsound_landmarks.sort_by_key(|&(l, n)| (std::cmp::Reverse(n), l));
     MapMetricsScore {
+        unsound_landmarks,
         landmarks: map.len(),
         triples: map.triple_count(),
         open_pct: m.open_pct,

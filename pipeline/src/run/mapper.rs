@@ -282,9 +282,13 @@ impl<C: Calculus> Mapper<C> {
         let current = record.index;
         let mut pending = std::mem::take(&mut self.held);
         let before = pending.len();
-        // Observations that waited long enough, or have too few fused partners at their
-        // station to be measured with, are given up.
-        pending.retain(|item| current <= item.station + HOLD_STATIONS && item.decided.len() >= 2);
+        // Observations that waited long enough, have no candidate left, or have too few fused
+        // partners at their station to be measured with, are given up.
+        pending.retain(|item| {
+            current <= item.station + HOLD_STATIONS
+                && !item.candidates.is_empty()
+                && item.decided.len() >= 2
+        });
         self.expired += before - pending.len();
         let mut resolved = 0;
         let mut done = vec![false; pending.len()];
