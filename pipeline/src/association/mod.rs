@@ -14,15 +14,16 @@
 //!    pairs of anchors are measured and compared with the candidate landmark's relations in
 //!    the map; a candidate with an empty overlap in any relation is rejected;
 //! 4. no candidate left → a new landmark; otherwise the observation is **held back** and
-//!    tried again when the map is tighter, where it is matched once every other candidate has
-//!    been rejected. Nothing is fused on a guess.
+//!    tried again when the map is tighter, where it becomes a new landmark once every
+//!    candidate has been rejected. Nothing is fused on a guess.
 //!
 //! Why a lone surviving candidate is not matched at once: a rejection is sound evidence (the
 //! map and the measurement exclude each other), a pass is not, since a loose map lets most
 //! look-alikes pass. On sixteen-station half-resolution marsyard and random surveys (`pipeline
 //! synth --scale 0.5 --stations 16`, seeds 1–6) lone survivors matched on a pass were wrong
-//! in 19 of 54 cases and retried held-back observations in 33 of 58, against 30 of about 2300
-//! for registration anchors; the wrong ones made 8 of those 12 maps unsound.
+//! in 19 of 54 cases and retried held-back observations in 33 of 58 (and still wrong when
+//! matched by elimination of the other candidates), against 30 of about 2300 for registration
+//! anchors; the wrong ones made 8 of those 12 maps unsound.
 
 mod gallery;
 mod registration;
@@ -51,8 +52,8 @@ pub struct AssociationSettings {
     pub scales: AppearanceScales,
     /// Largest descriptor distance of a candidate.
     pub gate: f64,
-    /// Triples, with relations the map constrains, a candidate must have been tested on: to
-    /// stay a candidate when not seen lately, and to be matched by elimination.
+    /// Triples, with relations the map constrains, a candidate not seen lately must have been
+    /// tested on to stay a candidate.
     pub informative_triples: usize,
     /// Most anchor pairs tested per candidate (the most constrained first).
     pub tested_pairs: usize,
@@ -198,9 +199,14 @@ pub fn associate<C: Calculus>(
         .collect()
 }
 
-/// Re-decides one detection of an earlier station against the current map (held-back
-/// observations, 000 §VI-C "delayed until the map has converged further"). `decided` are the
-/// other detections of that station with their landmarks.
+/// Re-tests one held-back detection of an earlier station against the current map (000 §VI-C
+/// "delayed until the map has converged further"): the candidates the map still allows, empty
+/// when it rejects them all (a new landmark). `decided` are the other detections of that
+/// station with their landmarks; `None` when they took every candidate, which says nothing
+/// about which rock this one is (a new landmark would duplicate a rock never proposed).
+///
+/// A candidate left alone after the others were rejected is not matched: it is no surer than
+/// a lone pass, since the rock's own landmark need not have been among the look-alikes.
 pub fn reconsider<C: Calculus>(
     map: &Hypergraph<C>,
     panorama: &Panorama,
@@ -208,19 +214,16 @@ pub fn reconsider<C: Calculus>(
     candidates: &[LandmarkId],
     decided: &[(usize, LandmarkId)],
     settings: &AssociationSettings,
-) -> Decision {
+) -> Option<Vec<LandmarkId>> {
     let open: Vec<(LandmarkId, f64)> = candidates
         .iter()
         .filter(|l| !decided.iter().any(|d| d.1 == **l))
         .map(|&l| (l, settings.gate))
         .collect();
-    // Candidates lost to another detection of the station say nothing about which rock this
-    // one is: with none left it stays undecided rather than becoming a new landmark, which
-    // would duplicate a known rock that was never proposed.
     if open.is_empty() {
-        return Decision::HeldBack(Vec::new());
+        return None;
     }
-    let survivors = survivors(
+    let standing = survivors(
         map,
         panorama,
         detection,
@@ -229,16 +232,7 @@ pub fn reconsider<C: Calculus>(
         &|_| true,
         settings,
     );
-    match survivors.as_slice() {
-        [] => Decision::New,
-        // The others were rejected, on evidence the map constrains.
-        [(landmark, informative)]
-            if open.len() >= 2 && *informative >= settings.informative_triples =>
-        {
-            Decision::Matched(*landmark)
-        }
-        _ => Decision::HeldBack(survivors.iter().map(|s| s.0).collect()),
-    }
+    Some(standing.iter().map(|s| s.0).collect())
 }
 
 /// Landmarks whose looks are within the gate, nearest first.

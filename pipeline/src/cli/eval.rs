@@ -137,9 +137,21 @@ fn print_report(e: &Evaluation) {
     );
     for (name, m) in [("run", &e.map.run), ("exact", &e.map.exact)] {
         println!(
-            "  map ({name:<5}): {} landmarks, {} triples, {:.1} % open, {:.1} % of incorrect states removed, {:.1} % fully constrained, {} unsound relations",
-            m.landmarks, m.triples, m.open_pct, m.removed_incorrect_pct, m.fully_constrained_pct, m.unsound_relations
+            "  map ({name:<5}): {} landmarks, {} triples, {:.1} % open ({:.1} % among landmarks of one rock each), {:.1} % of incorrect states removed, {:.1} % fully constrained, {} unsound relations",
+            m.landmarks, m.triples, m.open_pct, m.open_pct_defined, m.removed_incorrect_pct, m.fully_constrained_pct, m.unsound_relations
         );
+        if !m.unsound_landmarks.is_empty() {
+            let worst: Vec<String> = m
+                .unsound_landmarks
+                .iter()
+                .take(5)
+                .map(|(l, n)| format!("{l} ({n})"))
+                .collect();
+            println!(
+                "    landmarks in most unsound relations: {}",
+                worst.join(", ")
+            );
+        }
     }
     if let Some(rng) = &e.map.rng {
         println!(

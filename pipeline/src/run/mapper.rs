@@ -277,24 +277,20 @@ impl<C: Calculus> Mapper<C> {
     }
 
     /// Tries every held-back observation against the current map; returns how many were
-    /// resolved and fused.
+    /// resolved (every candidate rejected: a new landmark) and fused.
     fn retry_held_back(&mut self, record: &mut StationRecord) -> usize {
         let current = record.index;
         let mut pending = std::mem::take(&mut self.held);
         let before = pending.len();
-        // Observations that waited long enough, have no candidate left, or have too few fused
-        // partners at their station to be measured with, are given up.
-        pending.retain(|item| {
-            current <= item.station + HOLD_STATIONS
-                && !item.candidates.is_empty()
-                && item.decided.len() >= 2
-        });
+        // Observations that waited long enough, or have too few fused partners at their
+        // station to be measured with, are given up.
+        pending.retain(|item| current <= item.station + HOLD_STATIONS && item.decided.len() >= 2);
         self.expired += before - pending.len();
         let mut resolved = 0;
         let mut done = vec![false; pending.len()];
         for k in 0..pending.len() {
             let item = &pending[k];
-            let decision = reconsider(
+            let standing = reconsider(
                 &self.map,
                 &item.panorama,
                 item.detection,
@@ -302,21 +298,25 @@ impl<C: Calculus> Mapper<C> {
                 &item.decided,
                 &self.association,
             );
-            let landmark = match decision {
-                Decision::Matched(l) => l,
-                Decision::New => self.next_landmark,
-                Decision::HeldBack(candidates) => {
+            match standing {
+                // Other detections of the station took every candidate: undecidable.
+                None => {
+                    done[k] = true;
+                    self.expired += 1;
+                    continue;
+                }
+                Some(candidates) if !candidates.is_empty() => {
                     pending[k].candidates = candidates;
                     continue;
                 }
-            };
-            done[k] = true;
+                // Every candidate rejected: a rock the map did not have.
+                Some(_) => done[k] = true,
+            }
+            let landmark = self.next_landmark;
             let batch = focused_observations(&self.map, item, landmark);
             match self.map.fuse(&batch) {
                 Ok(_) => {
-                    if landmark == self.next_landmark {
-                        self.next_landmark += 1;
-                    }
+                    self.next_landmark += 1;
                     self.gallery.observe(
                         landmark,
                         item.evidence.appearance.clone(),
@@ -325,13 +325,12 @@ impl<C: Calculus> Mapper<C> {
                     self.sightings
                         .push((item.station, item.primary_index, landmark));
                     resolved += 1;
-                    // The station's other held observations now know this detection's
-                    // landmark: a partner to measure with, and no longer a candidate.
+                    // The station's other held observations now have this detection's
+                    // landmark as a partner to measure with.
                     let (station, detection) = (item.station, item.detection);
                     for other in pending.iter_mut().filter(|o| o.station == station) {
                         if other.detection != detection {
                             other.decided.push((detection, landmark));
-                            other.candidates.retain(|&c| c != landmark);
                         }
                     }
                 }
