@@ -150,6 +150,25 @@ fn maps_half_resolution_surveys_soundly() {
     }
 }
 
+/// With the `rerun` feature, `--rrd` adds `run.rrd`. With `QRM_RECORDING_SAMPLES=DIR` the run
+/// is written to `DIR/demo-run`, for CI to check its recordings with the independent Python
+/// tools (the binary this test builds is the feature build, so CI needs no second one).
+#[cfg(feature = "rerun")]
+#[test]
+fn records_the_demo_run_for_rerun() {
+    let out = match std::env::var_os("QRM_RECORDING_SAMPLES") {
+        Some(dir) => PathBuf::from(dir).join("demo-run"),
+        None => scratch("demo-rrd"),
+    };
+    let _ = std::fs::remove_dir_all(&out);
+    let o = pipeline(&["run", "--images", DEMO, "--out", arg(&out), "--rrd"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for file in ["run.rrd", "run.mcap"] {
+        let size = std::fs::metadata(out.join(file)).map_or(0, |m| m.len());
+        assert!(size > 0, "{file} missing or empty");
+    }
+}
+
 #[test]
 fn fatal_input_errors_exit_2_and_write_nothing() {
     let empty = scratch("empty");
