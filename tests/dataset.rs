@@ -15,7 +15,11 @@ fn calibration(scale: f64) -> Calibration {
 }
 
 fn render(preset: Preset, stations: usize, stereo: bool, name: &str) -> (Truth, Calibration) {
-    let dir = std::env::temp_dir().join(format!("qrm-dataset-{name}-{}", std::process::id()));
+    let scratch = tempfile::Builder::new()
+        .prefix(&format!("qrm-dataset-{name}-"))
+        .tempdir()
+        .unwrap();
+    let dir = scratch.path();
     let calib = calibration(0.5);
     let truth = write_dataset(
         &dir,
@@ -40,7 +44,6 @@ fn render(preset: Preset, stations: usize, stereo: bool, name: &str) -> (Truth, 
     for image in &truth.images {
         assert!(dir.join(&image.file).is_file(), "{}", image.file);
     }
-    std::fs::remove_dir_all(&dir).ok();
     (truth, calib)
 }
 
@@ -124,7 +127,8 @@ fn stereo_disparity_matches_range_and_baseline() {
 #[test]
 fn committed_demo_dataset_is_reproduced_byte_for_byte() {
     let committed = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../datasets/demo");
-    let dir = std::env::temp_dir().join(format!("qrm-dataset-demo-{}", std::process::id()));
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
     let calib = calibration(0.25);
     let truth = write_dataset(
         &dir,
@@ -152,5 +156,4 @@ fn committed_demo_dataset_is_reproduced_byte_for_byte() {
             "datasets/demo/{file} differs from a fresh render"
         );
     }
-    std::fs::remove_dir_all(&dir).ok();
 }

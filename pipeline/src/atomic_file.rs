@@ -103,8 +103,8 @@ mod tests {
 
     #[test]
     fn writes_whole_files_and_leaves_nothing_on_failure() {
-        let dir = std::env::temp_dir().join(format!("qrm-atomic-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
         let target = dir.join("a.txt");
         write_bytes(&target, b"first").unwrap();
         write_bytes(&target, b"second").unwrap();
@@ -119,11 +119,10 @@ mod tests {
             |e| e.to_string(),
         );
         assert_eq!(failed, Err("encoder failed".to_string()));
-        let names: Vec<_> = std::fs::read_dir(&dir)
+        let names: Vec<_> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().file_name().into_string().unwrap())
             .collect();
         assert_eq!(names, ["a.txt"]);
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -108,7 +108,8 @@ fn measures_a_triple() {
 
 #[test]
 fn simulates_and_writes_outputs() {
-    let dir = std::env::temp_dir().join(format!("qrm-cli-sim-{}", std::process::id()));
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
     let o = run(&[
         "simulate",
         "single",
@@ -152,12 +153,12 @@ fn simulates_and_writes_outputs() {
             "{bad:?}"
         );
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn synthesises_a_dataset_and_rejects_bad_calibrations() {
-    let dir = std::env::temp_dir().join(format!("qrm-cli-synth-{}", std::process::id()));
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
     let o = run(&[
         "synth",
         "--preset",
@@ -214,5 +215,4 @@ fn synthesises_a_dataset_and_rejects_bad_calibrations() {
     ]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("height_m"));
     assert!(!std::path::Path::new("/tmp/never").exists());
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -2,7 +2,7 @@
 //! of bad input: a clear message naming the file, exit code 2 for fatal problems (nothing
 //! written), a warning and a skip for a single bad image.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../datasets/demo");
@@ -18,15 +18,32 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("qrm-run-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh temporary directory, removed when dropped.
+struct Scratch(tempfile::TempDir);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+fn scratch(name: &str) -> Scratch {
+    let dir = tempfile::Builder::new()
+        .prefix(&format!("qrm-run-{name}-"))
+        .tempdir()
+        .unwrap();
+    Scratch(dir)
 }
 
 /// A copy of the first `stations` demo stations with calib.toml (and truth.json).
-fn demo_copy(name: &str, stations: usize) -> PathBuf {
+fn demo_copy(name: &str, stations: usize) -> Scratch {
     let dir = scratch(name);
     for entry in std::fs::read_dir(DEMO).unwrap() {
         let path = entry.unwrap().path();
@@ -156,9 +173,10 @@ fn maps_half_resolution_surveys_soundly() {
 #[cfg(feature = "rerun")]
 #[test]
 fn records_the_demo_run_for_rerun() {
+    let temporary = scratch("demo-rrd");
     let out = match std::env::var_os("QRM_RECORDING_SAMPLES") {
-        Some(dir) => PathBuf::from(dir).join("demo-run"),
-        None => scratch("demo-rrd"),
+        Some(dir) => std::path::PathBuf::from(dir).join("demo-run"),
+        None => temporary.join("out"),
     };
     let _ = std::fs::remove_dir_all(&out);
     let o = pipeline(&["run", "--images", DEMO, "--out", arg(&out), "--rrd"]);
@@ -192,10 +210,13 @@ fn fatal_input_errors_exit_2_and_write_nothing() {
     let missing = empty.join("nope");
     for (images, needle) in [
         (missing.clone(), "does not exist".to_string()),
-        (empty.clone(), "holds no panoramas".to_string()),
-        (no_calib.clone(), "no calibration".to_string()),
-        (bad_calib.clone(), "focal_px".to_string()),
-        (all_corrupt.clone(), "none of the 2 stations".to_string()),
+        (empty.to_path_buf(), "holds no panoramas".to_string()),
+        (no_calib.to_path_buf(), "no calibration".to_string()),
+        (bad_calib.to_path_buf(), "focal_px".to_string()),
+        (
+            all_corrupt.to_path_buf(),
+            "none of the 2 stations".to_string(),
+        ),
     ] {
         let out = scratch("fatal-out");
         let o = pipeline(&["run", "--images", arg(&images), "--out", arg(&out)]);

@@ -2,31 +2,24 @@
 //! a PNG from its header, which checks the encoder's output without a decoder dependency.
 
 use std::ops::Deref;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// An empty directory under the system temporary directory, unique to this process and test,
-/// removed when dropped.
-pub(super) struct Scratch(PathBuf);
+/// An empty temporary directory, removed when dropped.
+pub(super) struct Scratch(tempfile::TempDir);
 
 impl Deref for Scratch {
     type Target = Path;
     fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        // Best effort: a leftover directory in the temporary directory is harmless.
-        let _ = std::fs::remove_dir_all(&self.0);
+        self.0.path()
     }
 }
 
 /// A fresh [`Scratch`] directory for `test`.
 pub(super) fn scratch_dir(test: &str) -> Scratch {
-    let dir = std::env::temp_dir().join(format!("qrm-plot-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create scratch directory");
+    let dir = tempfile::Builder::new()
+        .prefix(&format!("qrm-plot-{test}-"))
+        .tempdir()
+        .expect("create scratch directory");
     Scratch(dir)
 }
 

@@ -134,10 +134,11 @@ fn panorama() -> image::RgbImage {
     })
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("qrm-recording-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("qrm-recording-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn names_in(dir: &Path) -> Vec<String> {
@@ -220,14 +221,14 @@ fn check(value: &Value, schema: &Value, root: &Value, at: &str) {
 #[test]
 fn mcap_has_every_channel_once_per_station_matching_its_schema() {
     let dir = scratch("mcap");
-    let path = dir.join("run.mcap");
+    let path = dir.path().join("run.mcap");
     let panorama = image::RgbImage::new(8, 2);
     let mut recorder = McapRecorder::create(&path).unwrap();
     recorder.station(&station(0), &panorama).unwrap();
     assert!(!path.exists(), "the target appears only on finish");
     drop(recorder);
     assert!(
-        names_in(&dir).is_empty(),
+        names_in(dir.path()).is_empty(),
         "an unfinished recording leaves nothing"
     );
 
@@ -236,7 +237,7 @@ fn mcap_has_every_channel_once_per_station_matching_its_schema() {
         STATIONS,
         &panorama,
     );
-    assert_eq!(names_in(&dir), ["run.mcap"]);
+    assert_eq!(names_in(dir.path()), ["run.mcap"]);
     keep_sample(&path);
 
     let bytes = std::fs::read(&path).unwrap();
@@ -330,14 +331,14 @@ fn recording_errors_name_the_target() {
 #[test]
 fn rrd_is_written_whole_on_finish_only() {
     let dir = scratch("rrd");
-    let path = dir.join("run.rrd");
+    let path = dir.path().join("run.rrd");
     let panorama = panorama();
     let mut recorder = RerunRecorder::create(&path).unwrap();
     recorder.station(&station(0), &panorama).unwrap();
     assert!(!path.exists(), "the target appears only on finish");
     drop(recorder);
     assert!(
-        names_in(&dir).is_empty(),
+        names_in(dir.path()).is_empty(),
         "an unfinished recording leaves nothing"
     );
 
@@ -346,7 +347,7 @@ fn rrd_is_written_whole_on_finish_only() {
         STATIONS,
         &panorama,
     );
-    assert_eq!(names_in(&dir), ["run.rrd"]);
+    assert_eq!(names_in(dir.path()), ["run.rrd"]);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..4], b"RRF2", "an rrd stream header");
     // 16 halved panoramas of 2048×512 RGB are 50 MB raw; rerun's compression keeps them smaller.
