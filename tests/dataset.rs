@@ -22,7 +22,7 @@ fn render(preset: Preset, stations: usize, stereo: bool, name: &str) -> (Truth, 
     let dir = scratch.path();
     let calib = calibration(0.5);
     let truth = write_dataset(
-        &dir,
+        dir,
         &calib,
         Request {
             preset,
@@ -131,7 +131,7 @@ fn committed_demo_dataset_is_reproduced_byte_for_byte() {
     let dir = scratch.path();
     let calib = calibration(0.25);
     let truth = write_dataset(
-        &dir,
+        dir,
         &calib,
         Request {
             preset: Preset::Marsyard,
