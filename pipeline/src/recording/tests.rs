@@ -218,27 +218,38 @@ fn check(value: &Value, schema: &Value, root: &Value, at: &str) {
     }
 }
 
-#[test]
-fn mcap_has_every_channel_once_per_station_matching_its_schema() {
-    let dir = scratch("mcap");
-    let path = dir.path().join("run.mcap");
-    let panorama = image::RgbImage::new(8, 2);
-    let mut recorder = McapRecorder::create(&path).unwrap();
-    recorder.station(&station(0), &panorama).unwrap();
+/// Records `STATIONS` stations into `dir/file` with recorders from `create`, after checking
+/// that a recording dropped unfinished leaves nothing behind; returns the finished file.
+fn record_whole(
+    dir: &Path,
+    file: &str,
+    create: impl Fn(&Path) -> Box<dyn Recorder>,
+    panorama: &image::RgbImage,
+) -> PathBuf {
+    let path = dir.join(file);
+    let mut recorder = create(&path);
+    recorder.station(&station(0), panorama).unwrap();
     assert!(!path.exists(), "the target appears only on finish");
     drop(recorder);
     assert!(
-        names_in(dir.path()).is_empty(),
+        names_in(dir).is_empty(),
         "an unfinished recording leaves nothing"
     );
-
-    record(
-        Box::new(McapRecorder::create(&path).unwrap()),
-        STATIONS,
-        &panorama,
-    );
-    assert_eq!(names_in(dir.path()), ["run.mcap"]);
+    record(create(&path), STATIONS, panorama);
+    assert_eq!(names_in(dir), [file]);
     keep_sample(&path);
+    path
+}
+
+#[test]
+fn mcap_has_every_channel_once_per_station_matching_its_schema() {
+    let dir = scratch("mcap");
+    let path = record_whole(
+        dir.path(),
+        "run.mcap",
+        |path| Box::new(McapRecorder::create(path).unwrap()),
+        &image::RgbImage::new(8, 2),
+    );
 
     let bytes = std::fs::read(&path).unwrap();
     let summary = ::mcap::Summary::read(&bytes).unwrap().unwrap();
@@ -331,27 +342,14 @@ fn recording_errors_name_the_target() {
 #[test]
 fn rrd_is_written_whole_on_finish_only() {
     let dir = scratch("rrd");
-    let path = dir.path().join("run.rrd");
-    let panorama = panorama();
-    let mut recorder = RerunRecorder::create(&path).unwrap();
-    recorder.station(&station(0), &panorama).unwrap();
-    assert!(!path.exists(), "the target appears only on finish");
-    drop(recorder);
-    assert!(
-        names_in(dir.path()).is_empty(),
-        "an unfinished recording leaves nothing"
+    let path = record_whole(
+        dir.path(),
+        "run.rrd",
+        |path| Box::new(RerunRecorder::create(path).unwrap()),
+        &panorama(),
     );
-
-    record(
-        Box::new(RerunRecorder::create(&path).unwrap()),
-        STATIONS,
-        &panorama,
-    );
-    assert_eq!(names_in(dir.path()), ["run.rrd"]);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..4], b"RRF2", "an rrd stream header");
     // 16 halved panoramas of 2048×512 RGB are 50 MB raw; rerun's compression keeps them smaller.
     assert!(bytes.len() < 60_000_000, "{} bytes", bytes.len());
-    keep_sample(&path);
-    std::fs::remove_dir_all(&dir).ok();
 }
