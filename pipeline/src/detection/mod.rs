@@ -26,6 +26,16 @@ pub struct DetectorSettings {
     pub min_width_m: f64,
     /// Farthest rock kept, metres of flat-ground range at the contact row.
     pub max_range_m: f64,
+    /// A blob whose luminance varies less than this (standard deviation over mean) and which is
+    /// within `bright_ratio` of the regolith's brightness either way is a tint of the ground
+    /// (a dust drift just greyer than the row's median), not a rock: rocks are faceted and
+    /// shaded on one side, or differ in brightness.
+    pub min_texture: f32,
+    /// A blob whose top edge, read as flat ground, lies less than this many of its widths
+    /// beyond its contact is a patch lying on the ground (pebbles, clumps of them), not a rock
+    /// standing up from it: a flat patch as deep as it is wide reaches 1, any rock of that
+    /// width rises higher in the image.
+    pub min_rise: f64,
     /// A pixel whose `(r − b)/(r + g + b)` is this much below its row's median is rock: rocks
     /// are greyer than the red regolith, in sun and in shade alike.
     pub chroma_drop: f32,
@@ -47,6 +57,8 @@ impl Default for DetectorSettings {
         DetectorSettings {
             min_width_m: 0.12,
             max_range_m: 30.0,
+            min_rise: 0.9,
+            min_texture: 0.04,
             chroma_drop: 0.035,
             bright_ratio: 1.25,
             dark_ratio: 0.6,
@@ -250,8 +262,8 @@ fn along_columns(input: &[u8], out: &mut [u8], w: usize, f: fn(u8, u8) -> u8) {
 }
 
 /// The detection of `blob` (band rows offset by `top`), or `None` if it is empty, its contact
-/// row is at or above the horizon, or it is narrower than `min_width_m` or farther than
-/// `max_range_m`.
+/// row is at or above the horizon, it is narrower than `min_width_m` or farther than
+/// `max_range_m`, or it lies flat on the ground (`min_rise`) or is a tint of it (`min_texture`).
 fn accept(
     blob: Blob,
     ambiguous: bool,
@@ -266,15 +278,18 @@ fn accept(
     let contact_row = (blob.row_max + top + 1) as f64;
     let range = calib.ground_range(contact_row)?;
     let width_px = (blob.col_max - blob.col_min + 1) as f64;
+    let width_m = width_px * calib.column_width() * range;
+    let top_row = (blob.row_min + top) as f64;
+    let clipped = contact_row >= f64::from(calib.image.height);
+    let appearance = appearance_of(&blob);
     if range > settings.max_range_m
-        || width_px * calib.column_width() * range < settings.min_width_m
+        || width_m < settings.min_width_m
+        || (!clipped && lies_flat(top_row, range, width_m, calib, settings.min_rise))
+        || ground_tint(&appearance, settings)
     {
         return None;
     }
     let width = f64::from(calib.image.width);
-    let mean_luminance = blob.sum_luminance / n;
-    let variance = (blob.sum_luminance_sq / n - mean_luminance * mean_luminance).max(0.0);
-    let total: f64 = blob.sum_rgb.iter().sum::<f64>().max(1.0);
     Some(Detection {
         centroid: [
             (blob.sum_col / n).rem_euclid(width),
@@ -288,14 +303,38 @@ fn accept(
         ],
         pixels: blob.pixels,
         contact_row,
-        appearance: Appearance {
-            colour: blob.sum_rgb.map(|c| (c / total) as f32),
-            brightness: (blob.sum_ratio / n) as f32,
-            texture: (variance.sqrt() / mean_luminance.max(1.0)) as f32,
-            dark_fraction: (f64::from(blob.dark) / n) as f32,
-        },
+        appearance,
         ambiguous,
     })
+}
+
+/// The appearance statistics of a non-empty `blob`.
+fn appearance_of(blob: &Blob) -> Appearance {
+    let n = f64::from(blob.pixels);
+    let mean_luminance = blob.sum_luminance / n;
+    let variance = (blob.sum_luminance_sq / n - mean_luminance * mean_luminance).max(0.0);
+    let total: f64 = blob.sum_rgb.iter().sum::<f64>().max(1.0);
+    Appearance {
+        colour: blob.sum_rgb.map(|c| (c / total) as f32),
+        brightness: (blob.sum_ratio / n) as f32,
+        texture: (variance.sqrt() / mean_luminance.max(1.0)) as f32,
+        dark_fraction: (f64::from(blob.dark) / n) as f32,
+    }
+}
+
+/// Whether a blob looks like regolith of another tint: as bright as the ground (within
+/// `bright_ratio` either way) and smoother than `min_texture`.
+fn ground_tint(a: &Appearance, s: &DetectorSettings) -> bool {
+    a.texture < s.min_texture && a.brightness * s.bright_ratio > 1.0 && a.brightness < s.bright_ratio
+}
+
+/// Whether a blob from `top_row` down to a contact at `range` (metres), `width_m` wide, is no
+/// taller than flat ground `min_rise × width_m` deep: its top edge, read as ground, lies less
+/// than that beyond the contact. A blob reaching the horizon stands up.
+fn lies_flat(top_row: f64, range: f64, width_m: f64, calib: &Calibration, min_rise: f64) -> bool {
+    calib
+        .ground_range(top_row)
+        .is_some_and(|far| far - range < min_rise * width_m)
 }
 
 #[cfg(test)]
