@@ -325,7 +325,9 @@ fn appearance_of(blob: &Blob) -> Appearance {
 /// Whether a blob looks like regolith of another tint: as bright as the ground (within
 /// `bright_ratio` either way) and smoother than `min_texture`.
 fn ground_tint(a: &Appearance, s: &DetectorSettings) -> bool {
-    a.texture < s.min_texture && a.brightness * s.bright_ratio > 1.0 && a.brightness < s.bright_ratio
+    a.texture < s.min_texture
+        && a.brightness * s.bright_ratio > 1.0
+        && a.brightness < s.bright_ratio
 }
 
 /// Whether a blob from `top_row` down to a contact at `range` (metres), `width_m` wide, is no
@@ -339,7 +341,27 @@ fn lies_flat(top_row: f64, range: f64, width_m: f64, calib: &Calibration, min_ri
 
 #[cfg(test)]
 mod tests {
-    use super::close3;
+    use super::{close3, lies_flat};
+    use crate::calib::Calibration;
+
+    /// From the 1.5 m mast at 4 m: a patch on the ground 0.2 m wide and 0.1 m deep lies flat;
+    /// a rock as wide and 0.1 m tall rises above it.
+    #[test]
+    fn flat_patches_lie_flat_and_rocks_rise() {
+        let calib =
+            Calibration::parse(include_str!("../../../calib/default.toml"), "default").unwrap();
+        let patch_top = calib.ground_row(4.1);
+        assert!(lies_flat(patch_top, 4.0, 0.2, &calib, 0.9));
+        let rock_top = calib.row((0.1f64 - 1.5).atan2(4.0));
+        assert!(!lies_flat(rock_top, 4.0, 0.2, &calib, 0.9));
+        assert!(!lies_flat(
+            calib.elevation.horizon_row,
+            4.0,
+            0.2,
+            &calib,
+            0.9
+        ));
+    }
 
     /// A one-pixel crack inside a blob is bridged; the blob does not grow, even at the edge.
     #[test]
