@@ -47,6 +47,8 @@ pub struct DetectorSettings {
     pub dark_chroma_drop: f32,
     /// A blob is cut where its bottom edge lies this many rows (at least) under the concave
     /// hull of its bottom edge: one rock's bottom edge is concave, touching rocks notch it.
+    /// Small blobs need a shallow cut: two touching pebbles notch each other by a couple of
+    /// rows, and each half is then too narrow to keep.
     pub split_depth_px: f32,
     /// … or this fraction of the blob's height, if more (ragged edges grow with size).
     pub split_depth_fraction: f32,
@@ -63,7 +65,7 @@ impl Default for DetectorSettings {
             bright_ratio: 1.25,
             dark_ratio: 0.6,
             dark_chroma_drop: 0.02,
-            split_depth_px: 3.0,
+            split_depth_px: 2.0,
             split_depth_fraction: 0.15,
         }
     }
