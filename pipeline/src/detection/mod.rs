@@ -343,8 +343,25 @@ fn lies_flat(top_row: f64, range: f64, width_m: f64, calib: &Calibration, min_ri
 
 #[cfg(test)]
 mod tests {
-    use super::{close3, lies_flat};
+    use super::{close3, ground_tint, lies_flat, Appearance, DetectorSettings};
     use crate::calib::Calibration;
+
+    /// A smooth blob as bright as the regolith is a tint of it; a textured one, or a smooth
+    /// one clearly darker or brighter, may be a rock.
+    #[test]
+    fn smooth_ground_bright_blobs_are_tints() {
+        let s = DetectorSettings::default();
+        let blob = |brightness, texture| Appearance {
+            colour: [0.4, 0.33, 0.27],
+            brightness,
+            texture,
+            dark_fraction: 0.0,
+        };
+        assert!(ground_tint(&blob(1.05, 0.01), &s));
+        assert!(!ground_tint(&blob(1.05, 0.1), &s));
+        assert!(!ground_tint(&blob(0.7, 0.01), &s));
+        assert!(!ground_tint(&blob(1.3, 0.01), &s));
+    }
 
     /// From the 1.5 m mast at 4 m: a patch on the ground 0.2 m wide and 0.1 m deep lies flat;
     /// a rock as wide and 0.1 m tall rises above it.
