@@ -26,6 +26,16 @@ pub struct DetectorSettings {
     pub min_width_m: f64,
     /// Farthest rock kept, metres of flat-ground range at the contact row.
     pub max_range_m: f64,
+    /// A blob whose luminance varies less than this (standard deviation over mean) and which is
+    /// within `bright_ratio` of the regolith's brightness either way is a tint of the ground
+    /// (a dust drift just greyer than the row's median), not a rock: rocks are faceted and
+    /// shaded on one side, or differ in brightness.
+    pub min_texture: f32,
+    /// A blob whose top edge, read as flat ground, lies less than this many of its widths
+    /// beyond its contact is a patch lying on the ground (pebbles, clumps of them), not a rock
+    /// standing up from it: a flat patch as deep as it is wide reaches 1, any rock of that
+    /// width rises higher in the image.
+    pub min_rise: f64,
     /// A pixel whose `(r − b)/(r + g + b)` is this much below its row's median is rock: rocks
     /// are greyer than the red regolith, in sun and in shade alike.
     pub chroma_drop: f32,
@@ -37,6 +47,8 @@ pub struct DetectorSettings {
     pub dark_chroma_drop: f32,
     /// A blob is cut where its bottom edge lies this many rows (at least) under the concave
     /// hull of its bottom edge: one rock's bottom edge is concave, touching rocks notch it.
+    /// Small blobs need a shallow cut: two touching pebbles notch each other by a couple of
+    /// rows, and each half is then too narrow to keep.
     pub split_depth_px: f32,
     /// … or this fraction of the blob's height, if more (ragged edges grow with size).
     pub split_depth_fraction: f32,
@@ -47,11 +59,13 @@ impl Default for DetectorSettings {
         DetectorSettings {
             min_width_m: 0.12,
             max_range_m: 30.0,
+            min_rise: 0.9,
+            min_texture: 0.04,
             chroma_drop: 0.035,
             bright_ratio: 1.25,
             dark_ratio: 0.6,
             dark_chroma_drop: 0.02,
-            split_depth_px: 3.0,
+            split_depth_px: 2.0,
             split_depth_fraction: 0.15,
         }
     }
@@ -250,8 +264,8 @@ fn along_columns(input: &[u8], out: &mut [u8], w: usize, f: fn(u8, u8) -> u8) {
 }
 
 /// The detection of `blob` (band rows offset by `top`), or `None` if it is empty, its contact
-/// row is at or above the horizon, or it is narrower than `min_width_m` or farther than
-/// `max_range_m`.
+/// row is at or above the horizon, it is narrower than `min_width_m` or farther than
+/// `max_range_m`, or it lies flat on the ground (`min_rise`) or is a tint of it (`min_texture`).
 fn accept(
     blob: Blob,
     ambiguous: bool,
@@ -266,15 +280,18 @@ fn accept(
     let contact_row = (blob.row_max + top + 1) as f64;
     let range = calib.ground_range(contact_row)?;
     let width_px = (blob.col_max - blob.col_min + 1) as f64;
+    let width_m = width_px * calib.column_width() * range;
+    let top_row = (blob.row_min + top) as f64;
+    let clipped = contact_row >= f64::from(calib.image.height);
+    let appearance = appearance_of(&blob);
     if range > settings.max_range_m
-        || width_px * calib.column_width() * range < settings.min_width_m
+        || width_m < settings.min_width_m
+        || (!clipped && lies_flat(top_row, range, width_m, calib, settings.min_rise))
+        || ground_tint(&appearance, settings)
     {
         return None;
     }
     let width = f64::from(calib.image.width);
-    let mean_luminance = blob.sum_luminance / n;
-    let variance = (blob.sum_luminance_sq / n - mean_luminance * mean_luminance).max(0.0);
-    let total: f64 = blob.sum_rgb.iter().sum::<f64>().max(1.0);
     Some(Detection {
         centroid: [
             (blob.sum_col / n).rem_euclid(width),
@@ -288,19 +305,82 @@ fn accept(
         ],
         pixels: blob.pixels,
         contact_row,
-        appearance: Appearance {
-            colour: blob.sum_rgb.map(|c| (c / total) as f32),
-            brightness: (blob.sum_ratio / n) as f32,
-            texture: (variance.sqrt() / mean_luminance.max(1.0)) as f32,
-            dark_fraction: (f64::from(blob.dark) / n) as f32,
-        },
+        appearance,
         ambiguous,
     })
 }
 
+/// The appearance statistics of a non-empty `blob`.
+fn appearance_of(blob: &Blob) -> Appearance {
+    let n = f64::from(blob.pixels);
+    let mean_luminance = blob.sum_luminance / n;
+    let variance = (blob.sum_luminance_sq / n - mean_luminance * mean_luminance).max(0.0);
+    let total: f64 = blob.sum_rgb.iter().sum::<f64>().max(1.0);
+    Appearance {
+        colour: blob.sum_rgb.map(|c| (c / total) as f32),
+        brightness: (blob.sum_ratio / n) as f32,
+        texture: (variance.sqrt() / mean_luminance.max(1.0)) as f32,
+        dark_fraction: (f64::from(blob.dark) / n) as f32,
+    }
+}
+
+/// Whether a blob looks like regolith of another tint: as bright as the ground (within
+/// `bright_ratio` either way) and smoother than `min_texture`.
+fn ground_tint(a: &Appearance, s: &DetectorSettings) -> bool {
+    a.texture < s.min_texture
+        && a.brightness * s.bright_ratio > 1.0
+        && a.brightness < s.bright_ratio
+}
+
+/// Whether a blob from `top_row` down to a contact at `range` (metres), `width_m` wide, is no
+/// taller than flat ground `min_rise × width_m` deep: its top edge, read as ground, lies less
+/// than that beyond the contact. A blob reaching the horizon stands up.
+fn lies_flat(top_row: f64, range: f64, width_m: f64, calib: &Calibration, min_rise: f64) -> bool {
+    calib
+        .ground_range(top_row)
+        .is_some_and(|far| far - range < min_rise * width_m)
+}
+
 #[cfg(test)]
 mod tests {
-    use super::close3;
+    use super::{close3, ground_tint, lies_flat, Appearance, DetectorSettings};
+    use crate::calib::Calibration;
+
+    /// A smooth blob as bright as the regolith is a tint of it; a textured one, or a smooth
+    /// one clearly darker or brighter, may be a rock.
+    #[test]
+    fn smooth_ground_bright_blobs_are_tints() {
+        let s = DetectorSettings::default();
+        let blob = |brightness, texture| Appearance {
+            colour: [0.4, 0.33, 0.27],
+            brightness,
+            texture,
+            dark_fraction: 0.0,
+        };
+        assert!(ground_tint(&blob(1.05, 0.01), &s));
+        assert!(!ground_tint(&blob(1.05, 0.1), &s));
+        assert!(!ground_tint(&blob(0.7, 0.01), &s));
+        assert!(!ground_tint(&blob(1.3, 0.01), &s));
+    }
+
+    /// From the 1.5 m mast at 4 m: a patch on the ground 0.2 m wide and 0.1 m deep lies flat;
+    /// a rock as wide and 0.1 m tall rises above it.
+    #[test]
+    fn flat_patches_lie_flat_and_rocks_rise() {
+        let calib =
+            Calibration::parse(include_str!("../../../calib/default.toml"), "default").unwrap();
+        let patch_top = calib.ground_row(4.1);
+        assert!(lies_flat(patch_top, 4.0, 0.2, &calib, 0.9));
+        let rock_top = calib.row((0.1f64 - 1.5).atan2(4.0));
+        assert!(!lies_flat(rock_top, 4.0, 0.2, &calib, 0.9));
+        assert!(!lies_flat(
+            calib.elevation.horizon_row,
+            4.0,
+            0.2,
+            &calib,
+            0.9
+        ));
+    }
 
     /// A one-pixel crack inside a blob is bridged; the blob does not grow, even at the edge.
     #[test]
