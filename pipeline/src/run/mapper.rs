@@ -127,8 +127,8 @@ impl<C: Calculus> Mapper<C> {
         );
         record.seconds.range = start.elapsed().as_secs_f64();
         // Detections the detector doubts (possibly several rocks, or part of one), pieces
-        // touching another piece, and those whose bearing is too uncertain to measure with are
-        // not used.
+        // touching another piece, stacks, and those whose bearing is too uncertain to measure
+        // with are not used.
         let width = self.calib.image.width;
         let narrowest = MIN_COLUMNS.max(width / 512);
         let usable: Vec<usize> = (0..ranged.len())
@@ -136,6 +136,7 @@ impl<C: Calculus> Mapper<C> {
                 let d = &station.primary[i];
                 !d.ambiguous
                     && d.bbox[2] + 1 >= d.bbox[0] + narrowest
+                    && !stacked(d)
                     && !ranging::touches_neighbour(i, &station.primary, width)
                     && ranged[i].bearing.uncertainty < MAX_BEARING_UNCERTAINTY
             })
@@ -371,6 +372,18 @@ impl<C: Calculus> Mapper<C> {
 /// Narrowest usable detection, columns (at least a 512th of the panorama): slivers are mostly
 /// pieces of larger rocks, whose centroids say little about where the rock is.
 const MIN_COLUMNS: u32 = 3;
+
+/// Tallest height-to-width ratio of a single rock's footprint: rocks are wider than they stand
+/// tall (on the marsyard and random presets no visible footprint exceeds 1.44, 99 % stay under
+/// 1.15). A taller blob is a farther rock seen over a nearer one, whose contact row (the
+/// nearer rock's) and centroid (between the two) belong to neither.
+const MAX_ASPECT: f64 = 1.5;
+
+fn stacked(d: &Detection) -> bool {
+    let width = f64::from(d.bbox[2] - d.bbox[0] + 1);
+    let height = f64::from(d.bbox[3] - d.bbox[1] + 1);
+    height > MAX_ASPECT * width
+}
 
 /// Recent stations registered against (a rover moves a few metres between stations: the most
 /// recent ones share most landmarks with the current one).
