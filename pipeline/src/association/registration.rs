@@ -23,6 +23,13 @@ pub struct Frame {
     pub landmarks: Vec<(LandmarkId, Placed)>,
 }
 
+impl Frame {
+    /// Whether the frame holds enough placed landmarks for a registration to explain.
+    pub fn registrable(&self) -> bool {
+        self.landmarks.len() >= MIN_INLIERS
+    }
+}
+
 /// The correspondences of the best rigid motion: `(detection, landmark)`, and the motion
 /// (`[cos, sin, x, y]`: rotation, then shift) from the current station to the frame.
 #[derive(Clone, Debug, PartialEq)]

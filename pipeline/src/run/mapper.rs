@@ -244,9 +244,14 @@ impl<C: Calculus> Mapper<C> {
                         .filter_map(|&(position, landmark)| Some((landmark, placed[position]?)))
                         .collect(),
                 };
-                self.frames.push(frame);
-                if self.frames.len() > RECENT_FRAMES {
-                    self.frames.remove(0);
+                // A station that fused too few landmarks to register against does not push an
+                // older, useful one out: with no registrable frame left, every rock would come
+                // back as a new landmark.
+                if frame.registrable() {
+                    self.frames.push(frame);
+                    if self.frames.len() > RECENT_FRAMES {
+                        self.frames.remove(0);
+                    }
                 }
                 for (k, candidates) in held {
                     record.detections[usable[k]].association = Association::HeldBack {
