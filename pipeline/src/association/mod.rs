@@ -192,7 +192,7 @@ pub fn associate<C: Calculus>(
                 if survivors.is_empty() {
                     Decision::New
                 } else {
-                    Decision::HeldBack(survivors.iter().map(|s| s.0).collect())
+                    Decision::HeldBack(survivors)
                 }
             }
         })
@@ -223,7 +223,7 @@ pub fn reconsider<C: Calculus>(
     if open.is_empty() {
         return None;
     }
-    let standing = survivors(
+    Some(survivors(
         map,
         panorama,
         detection,
@@ -231,8 +231,7 @@ pub fn reconsider<C: Calculus>(
         decided,
         &|_| true,
         settings,
-    );
-    Some(standing.iter().map(|s| s.0).collect())
+    ))
 }
 
 /// Landmarks whose looks are within the gate, nearest first.
@@ -320,8 +319,7 @@ fn drop_inconsistent_anchors<C: Calculus>(
     }
 }
 
-/// 000 §VI-C for one detection: the candidates the map does not reject, with the number of
-/// triples each was tested on.
+/// 000 §VI-C for one detection: the candidates the map does not reject.
 fn survivors<C: Calculus>(
     map: &Hypergraph<C>,
     panorama: &Panorama,
@@ -330,7 +328,7 @@ fn survivors<C: Calculus>(
     anchors: &[(usize, LandmarkId)],
     recent: &(dyn Fn(LandmarkId) -> bool + Sync),
     settings: &AssociationSettings,
-) -> Vec<(LandmarkId, usize)> {
+) -> Vec<LandmarkId> {
     let taken = |l: LandmarkId| anchors.iter().any(|a| a.1 == l);
     candidates
         .iter()
@@ -341,8 +339,7 @@ fn survivors<C: Calculus>(
             // A landmark not seen lately stays a candidate only on evidence the map actually
             // constrains: otherwise every unknown rock would be held back for every old
             // look-alike, and the map would stop growing.
-            (recent(landmark) || informative >= settings.informative_triples)
-                .then_some((landmark, informative))
+            (recent(landmark) || informative >= settings.informative_triples).then_some(landmark)
         })
         .collect()
 }
@@ -387,4 +384,124 @@ fn test_candidate<C: Calculus>(
         }
     }
     Some(informative)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::edc::Edc;
+    use crate::measurement::{Bearing, RangeOrder};
+
+    /// Six rocks around the station, metres apart.
+    const FIELD: [[f64; 2]; 6] = [
+        [3.0, 1.0],
+        [5.0, -2.0],
+        [-4.0, 6.0],
+        [0.5, -7.0],
+        [8.0, 8.0],
+        [-6.0, -3.0],
+    ];
+
+    fn look() -> Appearance {
+        Appearance {
+            colour: [0.4, 0.33, 0.27],
+            brightness: 1.1,
+            texture: 0.2,
+            dark_fraction: 0.1,
+        }
+    }
+
+    fn at(point: [f64; 2]) -> Placed {
+        Placed { point, radius: 0.3 }
+    }
+
+    /// The station's detections at `points` (bearings from the positions, no range order),
+    /// all alike, with landmarks 0‥6 in the gallery.
+    fn station(points: &[[f64; 2]]) -> (Gallery, Panorama, Vec<Evidence>, Vec<Option<Placed>>) {
+        let mut gallery = Gallery::default();
+        for l in 0..=6 {
+            gallery.observe(l, look(), None);
+        }
+        let bearings = points
+            .iter()
+            .map(|p| Bearing {
+                angle: p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU),
+                uncertainty: 0.01,
+            })
+            .collect();
+        let panorama = Panorama::new(bearings, RangeOrder::unordered(points.len())).unwrap();
+        let evidence = points
+            .iter()
+            .map(|_| Evidence {
+                appearance: look(),
+                width: None,
+            })
+            .collect();
+        let placed = points.iter().map(|&p| Some(at(p))).collect();
+        (gallery, panorama, evidence, placed)
+    }
+
+    fn frame(points: &[[f64; 2]]) -> Frame {
+        Frame {
+            landmarks: points
+                .iter()
+                .enumerate()
+                .map(|(l, &p)| (l as LandmarkId, at(p)))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn registered_landmarks_are_matched_and_a_lone_look_alike_is_held_back() {
+        // Landmark 6 lies where the motion puts detection 6, but just as near detection 7 (a
+        // rock of another look): registration leaves it unanchored, placement and the empty
+        // map cannot reject it, and a pass is no evidence.
+        let mut points = FIELD.to_vec();
+        points.extend([[-1.0, 9.0], [-1.5, 9.0]]);
+        let (gallery, panorama, mut evidence, placed) = station(&points);
+        evidence[7].appearance = Appearance {
+            colour: [0.2, 0.3, 0.5],
+            brightness: 3.0,
+            texture: 0.6,
+            dark_fraction: 0.5,
+        };
+        let mut landmarks = FIELD.to_vec();
+        landmarks.push([-1.25, 9.0]);
+        let decisions = associate(
+            &Hypergraph::<Edc>::new(),
+            &gallery,
+            &panorama,
+            &evidence,
+            &placed,
+            &[frame(&landmarks)],
+            &AssociationSettings::default(),
+        );
+        for (i, decision) in decisions.iter().take(6).enumerate() {
+            assert_eq!(*decision, Decision::Matched(i as LandmarkId));
+        }
+        assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
+        assert_eq!(decisions[7], Decision::New);
+    }
+
+    #[test]
+    fn a_pair_most_frames_holding_its_landmark_reject_is_no_anchor() {
+        // Two later frames place landmark 0 far from detection 0: only one of three agrees.
+        let mut moved = FIELD;
+        moved[0] = [-9.0, 9.0];
+        let (gallery, panorama, evidence, placed) = station(&FIELD);
+        let frames = [frame(&FIELD), frame(&moved), frame(&moved)];
+        let decisions = associate(
+            &Hypergraph::<Edc>::new(),
+            &gallery,
+            &panorama,
+            &evidence,
+            &placed,
+            &frames,
+            &AssociationSettings::default(),
+        );
+        assert_ne!(decisions[0], Decision::Matched(0));
+        for (i, decision) in decisions.iter().enumerate().skip(1) {
+            assert_eq!(*decision, Decision::Matched(i as LandmarkId));
+        }
+    }
 }
