@@ -441,6 +441,27 @@ mod tests {
         (gallery, panorama, evidence, placed)
     }
 
+    /// Associates the station against `frames` on an empty map with default settings.
+    fn associate_station(
+        (gallery, panorama, evidence, placed): &(
+            Gallery,
+            Panorama,
+            Vec<Evidence>,
+            Vec<Option<Placed>>,
+        ),
+        frames: &[Frame],
+    ) -> Vec<Decision> {
+        associate(
+            &Hypergraph::<Edc>::new(),
+            gallery,
+            panorama,
+            evidence,
+            placed,
+            frames,
+            &AssociationSettings::default(),
+        )
+    }
+
     fn frame(points: &[[f64; 2]]) -> Frame {
         Frame {
             landmarks: points
@@ -458,8 +479,8 @@ mod tests {
         // map cannot reject it, and a pass is no evidence.
         let mut points = FIELD.to_vec();
         points.extend([[-1.0, 9.0], [-1.5, 9.0]]);
-        let (gallery, panorama, mut evidence, placed) = station(&points);
-        evidence[7].appearance = Appearance {
+        let mut station = station(&points);
+        station.2[7].appearance = Appearance {
             colour: [0.2, 0.3, 0.5],
             brightness: 3.0,
             texture: 0.6,
@@ -467,15 +488,7 @@ mod tests {
         };
         let mut landmarks = FIELD.to_vec();
         landmarks.push([-1.25, 9.0]);
-        let decisions = associate(
-            &Hypergraph::<Edc>::new(),
-            &gallery,
-            &panorama,
-            &evidence,
-            &placed,
-            &[frame(&landmarks)],
-            &AssociationSettings::default(),
-        );
+        let decisions = associate_station(&station, &[frame(&landmarks)]);
         for (i, decision) in decisions.iter().take(6).enumerate() {
             assert_eq!(*decision, Decision::Matched(i as LandmarkId));
         }
@@ -488,17 +501,8 @@ mod tests {
         // Two later frames place landmark 0 far from detection 0: only one of three agrees.
         let mut moved = FIELD;
         moved[0] = [-9.0, 9.0];
-        let (gallery, panorama, evidence, placed) = station(&FIELD);
         let frames = [frame(&FIELD), frame(&moved), frame(&moved)];
-        let decisions = associate(
-            &Hypergraph::<Edc>::new(),
-            &gallery,
-            &panorama,
-            &evidence,
-            &placed,
-            &frames,
-            &AssociationSettings::default(),
-        );
+        let decisions = associate_station(&station(&FIELD), &frames);
         assert_ne!(decisions[0], Decision::Matched(0));
         for (i, decision) in decisions.iter().enumerate().skip(1) {
             assert_eq!(*decision, Decision::Matched(i as LandmarkId));
