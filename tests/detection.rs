@@ -26,7 +26,7 @@ fn score_stations(preset: Preset, stations: &[usize]) -> Score {
         let truth = visible_rocks(&world, &calib, pose, Eye::Left, &r);
         let image = image::RgbImage::from_raw(r.width, r.height, r.rgb).unwrap();
         score.add(
-            &detect(&image, &calib, &settings),
+            &detect(&image, None, &calib, &settings),
             &truth,
             &calib,
             &settings,
@@ -87,7 +87,7 @@ fn demo_set_low_resolution() {
             .unwrap()
             .into_rgb8();
         score.add(
-            &detect(&image, &calib, &settings),
+            &detect(&image, None, &calib, &settings),
             &t.rocks,
             &calib,
             &settings,
@@ -102,15 +102,15 @@ fn degenerate_images_give_nothing() {
     let calib = calibration();
     let settings = DetectorSettings::default();
     let black = image::RgbImage::new(calib.image.width, calib.image.height);
-    assert!(detect(&black, &calib, &settings).is_empty());
+    assert!(detect(&black, None, &calib, &settings).is_empty());
     let tiny = image::RgbImage::new(3, 2);
-    assert!(detect(&tiny, &calib, &settings).is_empty());
+    assert!(detect(&tiny, None, &calib, &settings).is_empty());
     let flat = image::RgbImage::from_pixel(
         calib.image.width,
         calib.image.height,
         image::Rgb([180, 110, 70]),
     );
-    assert!(detect(&flat, &calib, &settings).is_empty());
+    assert!(detect(&flat, None, &calib, &settings).is_empty());
 }
 
 /// A grey rock (lit above, shaded below) painted across the seam, with a red-hued shadow below
@@ -139,7 +139,7 @@ fn seam_rock_shadow_and_pebble() {
             image.put_pixel(col, row, grey);
         }
     }
-    let found = detect(&image, &calib, &DetectorSettings::default());
+    let found = detect(&image, None, &calib, &DetectorSettings::default());
     assert_eq!(found.len(), 1, "{found:?}");
     let d = &found[0];
     assert_eq!(d.bbox, [w - 20, 400, w + 24, 439]);

@@ -77,7 +77,7 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
         let image = image::open(file)?.into_rgb8();
         decode += start.elapsed().as_secs_f64();
         let start = Instant::now();
-        let found = detect(&image, &calib, &settings);
+        let found = detect(&image, None, &calib, &settings);
         detecting.push(start.elapsed().as_secs_f64());
         let name = file
             .file_name()

@@ -184,7 +184,8 @@ impl Calibration {
         Ok(())
     }
 
-    fn sign(&self) -> f64 {
+    /// `+1` when columns grow counter-clockwise, `−1` when clockwise.
+    pub fn column_sign(&self) -> f64 {
         match self.azimuth.direction {
             ColumnDirection::CounterClockwise => 1.0,
             ColumnDirection::Clockwise => -1.0,
@@ -199,13 +200,13 @@ impl Calibration {
     /// Azimuth (radians, in `[0, 2π)`) of continuous column coordinate `column` (0 = left edge
     /// of column 0; the centre of column `c` is `c + 0.5`).
     pub fn azimuth(&self, column: f64) -> f64 {
-        (self.azimuth.column0_deg.to_radians() + self.sign() * column * self.column_width())
+        (self.azimuth.column0_deg.to_radians() + self.column_sign() * column * self.column_width())
             .rem_euclid(TAU)
     }
 
     /// Continuous column coordinate (in `[0, width)`) of `azimuth` (radians).
     pub fn column(&self, azimuth: f64) -> f64 {
-        let turns = self.sign() * (azimuth - self.azimuth.column0_deg.to_radians());
+        let turns = self.column_sign() * (azimuth - self.azimuth.column0_deg.to_radians());
         (turns.rem_euclid(TAU) / self.column_width()).min(f64::from(self.image.width) - 1e-9)
     }
 

@@ -121,3 +121,84 @@ pub(super) fn blob_of(
     }
     blob
 }
+
+/// Where each pixel of a set sits in it, by (column, row): a dense grid over the set's
+/// bounding box, cheaper than hashing for blob-sized sets.
+pub(super) struct PixelIndex {
+    col0: i64,
+    row0: i64,
+    cols: i64,
+    rows: i64,
+    slots: Vec<u32>,
+}
+
+impl PixelIndex {
+    pub fn new(pixels: &[(u32, u32)]) -> PixelIndex {
+        let (mut c0, mut r0, mut c1, mut r1) = (u32::MAX, u32::MAX, 0, 0);
+        for &(c, r) in pixels {
+            (c0, r0, c1, r1) = (c0.min(c), r0.min(r), c1.max(c), r1.max(r));
+        }
+        let (cols, rows) = if pixels.is_empty() {
+            (0, 0)
+        } else {
+            (i64::from(c1 - c0) + 1, i64::from(r1 - r0) + 1)
+        };
+        let mut index = PixelIndex {
+            col0: i64::from(c0),
+            row0: i64::from(r0),
+            cols,
+            rows,
+            slots: vec![u32::MAX; (cols * rows) as usize],
+        };
+        for (k, &(c, r)) in pixels.iter().enumerate() {
+            let slot = index.slot(i64::from(c), i64::from(r)).unwrap_or(0);
+            index.slots[slot] = k as u32;
+        }
+        index
+    }
+
+    fn slot(&self, col: i64, row: i64) -> Option<usize> {
+        let (c, r) = (col - self.col0, row - self.row0);
+        ((0..self.cols).contains(&c) && (0..self.rows).contains(&r))
+            .then(|| (r * self.cols + c) as usize)
+    }
+
+    /// The position in the set of the pixel at (`col`, `row`), if it belongs to the set.
+    pub fn get(&self, col: i64, row: i64) -> Option<usize> {
+        let k = self.slots[self.slot(col, row)?];
+        (k != u32::MAX).then_some(k as usize)
+    }
+}
+
+/// The 8-connected parts of a set of pixels, each in the input's order.
+pub(super) fn connected(pixels: &[(u32, u32)]) -> Vec<Component> {
+    let index = PixelIndex::new(pixels);
+    let mut part = vec![usize::MAX; pixels.len()];
+    let mut count = 0;
+    for start in 0..pixels.len() {
+        if part[start] != usize::MAX {
+            continue;
+        }
+        part[start] = count;
+        let mut stack = vec![start];
+        while let Some(k) = stack.pop() {
+            let (col, row) = (i64::from(pixels[k].0), i64::from(pixels[k].1));
+            for dc in -1..=1 {
+                for dr in -1..=1 {
+                    if let Some(j) = index.get(col + dc, row + dr) {
+                        if part[j] == usize::MAX {
+                            part[j] = count;
+                            stack.push(j);
+                        }
+                    }
+                }
+            }
+        }
+        count += 1;
+    }
+    let mut parts = vec![Vec::new(); count];
+    for (&p, &k) in pixels.iter().zip(&part) {
+        parts[k].push(p);
+    }
+    parts
+}

@@ -10,12 +10,14 @@
 //! the flat-ground range of their contact row, which removes pebbles at every resolution.
 
 mod components;
+mod parallax;
 mod score;
 mod split;
 
 use crate::calib::Calibration;
 use components::{blob_of, label_wrapped, Blob};
 use kornia_image::{Image, ImageSize};
+pub use parallax::ParallaxRule;
 pub use score::{detectable, median_and_max, Score};
 use serde::{Deserialize, Serialize};
 
@@ -52,6 +54,8 @@ pub struct DetectorSettings {
     pub split_depth_px: f32,
     /// … or this fraction of the blob's height, if more (ragged edges grow with size).
     pub split_depth_fraction: f32,
+    /// When a blob holding a nearer and a farther rock is separated by stereo parallax.
+    pub parallax: ParallaxRule,
 }
 
 impl Default for DetectorSettings {
@@ -67,6 +71,17 @@ impl Default for DetectorSettings {
             dark_chroma_drop: 0.02,
             split_depth_px: 2.0,
             split_depth_fraction: 0.15,
+            parallax: ParallaxRule {
+                radius: 2,
+                min_pixels: 60,
+                min_step_px: 1.0,
+                min_step_fraction: 0.05,
+                step_ratio: 0.4,
+                min_depth_halfwidths: 1.0,
+                min_share: 0.05,
+                min_fragment: 30,
+                sliver_fraction: 0.1,
+            },
         }
     }
 }
@@ -103,10 +118,13 @@ pub struct Appearance {
     pub dark_fraction: f32,
 }
 
-/// Detects rocks in `image`, sorted by centroid column. An image whose size differs from the
-/// calibration's yields no detections (its geometry would be meaningless).
+/// Detects rocks in `image`, sorted by centroid column. Given the right panorama of its
+/// stereo pair (`image` being the left), blobs of a nearer and a farther rock are also
+/// separated by parallax. An image whose size differs from the calibration's yields no
+/// detections (its geometry would be meaningless); a right panorama of another size is ignored.
 pub fn detect(
     image: &image::RgbImage,
+    right: Option<&image::RgbImage>,
     calib: &Calibration,
     settings: &DetectorSettings,
 ) -> Vec<Detection> {
@@ -148,9 +166,62 @@ pub fn detect(
         fraction: settings.split_depth_fraction,
         min_columns: 3,
     };
+    let luminance = |img: &image::RgbImage| -> Vec<u16> {
+        img.as_raw()[top * w * 3..]
+            .chunks_exact(3)
+            .map(|p| u16::from(p[0]) + u16::from(p[1]) + u16::from(p[2]))
+            .collect()
+    };
+    let bands = right
+        .filter(|r| r.dimensions() == image.dimensions())
+        .map(|r| (luminance(image), luminance(r)));
+    // The right camera sees a point turned towards increasing azimuth.
+    let partner = bands.as_ref().map(|(own, other)| parallax::Partner {
+        own,
+        other,
+        width: w,
+        rows,
+        direction: if calib.column_sign() > 0.0 { 1 } else { -1 },
+        column_width: calib.column_width(),
+        baseline_m: calib.stereo.baseline_m,
+    });
+    // The search reaches the shift of a rock somewhat nearer than the blob's lowest row reads
+    // on flat ground (a rock's face overhangs its foot); a blob cut off by the image's bottom
+    // may hold a rock nearer still.
+    let max_shift = |pixels: &components::Component| -> usize {
+        let bottom = pixels.iter().map(|p| p.1 as usize).max().unwrap_or(0);
+        let margin = if bottom + 1 >= rows { 0.5 } else { 0.8 };
+        let nearest = calib
+            .ground_range((bottom + top + 1) as f64)
+            .map(|r| (margin * r).max(0.5));
+        nearest.map_or(0, |range| {
+            (calib.stereo_disparity(range) / calib.column_width()).ceil() as usize + 3
+        })
+    };
     let mut detections: Vec<Detection> = label_wrapped(&mask, w, rows)
         .into_iter()
-        .flat_map(|c| split::split(c, rule))
+        .flat_map(|c| match &partner {
+            Some(partner) => {
+                let shift = max_shift(&c);
+                parallax::layers(c, partner, shift, settings.parallax)
+            }
+            None => vec![parallax::Layer {
+                pixels: c,
+                farther: false,
+            }],
+        })
+        .flat_map(|layer| {
+            // A farther layer's bottom edge is the nearer rock's outline, notched where that
+            // outline rises: the notch rule would cut the farther rock in two.
+            if layer.farther {
+                vec![split::Piece {
+                    pixels: layer.pixels,
+                    ambiguous: true,
+                }]
+            } else {
+                split::split(layer.pixels, rule)
+            }
+        })
         .filter_map(|piece| {
             let blob = blob_of(&piece.pixels, w, &sample);
             accept(blob, piece.ambiguous, top, calib, settings)

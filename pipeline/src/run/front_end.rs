@@ -60,8 +60,10 @@ pub fn detect_station(
             }
         });
     let start = Instant::now();
-    let primary_detections = detect(&primary, calib, settings);
-    let right_detections = right.as_ref().map(|r| detect(r, calib, settings));
+    // Only the primary (left) panorama's blobs are separated by parallax: the right one's
+    // detections serve the stereo cue, which takes only lone blobs.
+    let primary_detections = detect(&primary, right.as_ref(), calib, settings);
+    let right_detections = right.as_ref().map(|r| detect(r, None, calib, settings));
     detect_seconds += start.elapsed().as_secs_f64();
     let mut files = vec![name(&station.primary)];
     if let Some(path) = station.right.as_ref().filter(|_| right.is_some()) {

@@ -1,0 +1,414 @@
+//! Separating rocks at different ranges by stereo parallax (000 §IV, range cue (c)). A farther
+//! rock seen over or beside a nearer one of the same tint merges with it in the mask, and the
+//! nearer rock hides the farther one's bottom edge, so the notch rule of [`super::split`] cannot
+//! see it. The other camera of the rotating head sees every point turned in azimuth by
+//! `2·asin(b / 2d)`, less for the farther rock. Each blob pixel's shift is found by block
+//! matching against the other panorama; a blob whose shifts fall into two groups apart by a
+//! step (an occluding edge) rather than a slope (one rock's curved face), and far enough apart
+//! in range that two rocks fit, is separated into a nearer and a farther layer.
+
+use super::components::{connected, Component, PixelIndex};
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+
+/// The other panorama of the stereo pair, for block matching.
+pub(super) struct Partner<'a> {
+    /// Luminance (`r + g + b`) of this panorama's ground band and of the other's, row-major.
+    pub own: &'a [u16],
+    pub other: &'a [u16],
+    pub width: usize,
+    pub rows: usize,
+    /// `+1` or `−1`: the other camera sees a point this many columns per pixel of shift.
+    pub direction: isize,
+    /// Radians per column, and the stereo baseline (metres): shifts to ranges.
+    pub column_width: f64,
+    pub baseline_m: f64,
+}
+
+impl Partner<'_> {
+    /// Range (metres) of a point seen shifted by `shift` columns (`Calibration::stereo_range`).
+    fn range(&self, shift: f32) -> f64 {
+        self.baseline_m / (2.0 * (0.5 * f64::from(shift.max(0.01)) * self.column_width).sin())
+    }
+}
+
+/// When a blob is separated by parallax (`DetectorSettings::parallax`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParallaxRule {
+    /// Window half-size of the block matching, pixels.
+    pub radius: usize,
+    /// Blobs with fewer pixels are left whole (too few windows to tell two groups apart).
+    pub min_pixels: usize,
+    /// The shift jumps across the border between the groups by this many pixels at least
+    /// (matching noise) …
+    pub min_step_px: f32,
+    /// … and by this fraction of the nearer group's shift …
+    pub min_step_fraction: f32,
+    /// … and by this fraction of the difference of the groups' means: a step, where one
+    /// rock's curved face would show a slope.
+    pub step_ratio: f32,
+    /// The jump puts the farther surface behind the nearer by this many of the nearer layer's
+    /// half-widths at least: two rocks cannot overlap, while one rock's face curves back by
+    /// about its half-width from its middle to its sides.
+    pub min_depth_halfwidths: f64,
+    /// Each group holds at least this fraction of the blob's reliable pixels.
+    pub min_share: f32,
+    /// Fragments of a layer smaller than this (pixels) join the other layer.
+    pub min_fragment: usize,
+    /// Disconnected parts of a separated layer smaller than this fraction of its largest part
+    /// are dropped.
+    pub sliver_fraction: f32,
+}
+
+/// A connected part of a blob at one range: `farther` if some nearer rock of the blob may hide part of it.
+pub(super) struct Layer {
+    pub pixels: Component,
+    pub farther: bool,
+}
+
+/// The layers of `pixels` (unwrapped columns); one layer if the blob is at one range.
+/// `max_shift` bounds the search (the shift of the nearest range the blob's lowest row allows).
+/// Layers are separated again, for rocks one behind another behind another.
+pub(super) fn layers(
+    pixels: Component,
+    partner: &Partner,
+    max_shift: usize,
+    rule: ParallaxRule,
+) -> Vec<Layer> {
+    if pixels.len() < rule.min_pixels || max_shift < 2 {
+        return vec![Layer {
+            pixels,
+            farther: false,
+        }];
+    }
+    let shifts = pixel_shifts(&pixels, partner, max_shift, rule.radius);
+    let mut out = Vec::new();
+    let mut pending = vec![(pixels, shifts, false, 0)];
+    while let Some((pixels, shifts, farther, depth)) = pending.pop() {
+        let labels = if depth < 2 {
+            separate(&pixels, &shifts, partner, rule)
+        } else {
+            None
+        };
+        let Some(labels) = labels else {
+            if depth == 0 {
+                out.push(Layer { pixels, farther });
+            } else {
+                // A separated layer may come apart; its slivers (window-sized runs along the
+                // other layer's edge) are dropped rather than reported as rocks.
+                let parts = connected(&pixels);
+                let largest = parts.iter().map(Vec::len).max().unwrap_or(0);
+                let keep =
+                    ((rule.sliver_fraction * largest as f32) as usize).max(rule.min_fragment);
+                out.extend(
+                    parts
+                        .into_iter()
+                        .filter(|p| p.len() >= keep)
+                        .map(|pixels| Layer { pixels, farther }),
+                );
+            }
+            continue;
+        };
+        let (mut near, mut far) = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
+        for ((p, s), nearer) in pixels.into_iter().zip(shifts).zip(labels) {
+            let side = if nearer { &mut near } else { &mut far };
+            side.0.push(p);
+            side.1.push(s);
+        }
+        pending.push((near.0, near.1, farther, depth + 1));
+        pending.push((far.0, far.1, true, depth + 1));
+    }
+    out
+}
+
+/// Which pixels are nearer (`true`), if the blob's shifts show two ranges: the threshold
+/// between all shifts' two groups is tried first, then those within either group (three rocks
+/// one behind another form three groups).
+fn separate(
+    pixels: &Component,
+    shifts: &[Option<f32>],
+    partner: &Partner,
+    rule: ParallaxRule,
+) -> Option<Vec<bool>> {
+    if pixels.len() < rule.min_pixels {
+        return None;
+    }
+    let mut reliable: Vec<f32> = shifts.iter().flatten().copied().collect();
+    if reliable.len() < rule.min_pixels / 2 {
+        return None;
+    }
+    reliable.sort_by(f32::total_cmp);
+    let (threshold, k) = two_groups(&reliable)?;
+    let mut candidates = vec![threshold];
+    candidates.extend(two_groups(&reliable[..k]).map(|t| t.0));
+    candidates.extend(two_groups(&reliable[k..]).map(|t| t.0));
+    let index = PixelIndex::new(pixels);
+    candidates
+        .into_iter()
+        .find_map(|t| separate_at(pixels, &index, shifts, &reliable, t, partner, rule))
+}
+
+/// The labels of a separation of the blob at shift `threshold`, if it passes `rule`.
+fn separate_at(
+    pixels: &Component,
+    index: &PixelIndex,
+    shifts: &[Option<f32>],
+    reliable: &[f32],
+    threshold: f32,
+    partner: &Partner,
+    rule: ParallaxRule,
+) -> Option<Vec<bool>> {
+    let k = reliable.partition_point(|&s| s <= threshold);
+    let share = k.min(reliable.len() - k) as f32 / reliable.len() as f32;
+    if share < rule.min_share || share == 0.0 {
+        return None;
+    }
+    let mean = |s: &[f32]| s.iter().sum::<f32>() / s.len() as f32;
+    let (far, near) = (mean(&reliable[..k]), mean(&reliable[k..]));
+    if near - far < rule.min_step_px.max(rule.min_step_fraction * near) {
+        return None;
+    }
+    let mut labels = fill_labels(pixels, index, shifts, threshold);
+    absorb_fragments(pixels, index, &mut labels, rule.min_fragment);
+    let near_pixels: Component = pixels
+        .iter()
+        .zip(&labels)
+        .filter(|(_, &nearer)| nearer)
+        .map(|(&p, _)| p)
+        .collect();
+    if near_pixels.is_empty() || near_pixels.len() == pixels.len() {
+        return None;
+    }
+    let widest = connected(&near_pixels)
+        .iter()
+        .map(|c| column_span(c))
+        .fold(0.0, f64::max);
+    let near_range = partner.range(near);
+    let half_width = 0.5 * widest * partner.column_width * near_range;
+    // The jump across the border, not the groups' means, says how far apart the two surfaces
+    // are: the means also hold each surface's own slope.
+    let step = border_step(pixels, index, shifts, &labels, rule.radius)?;
+    let behind = partner.range(near - step) - near_range;
+    (step >= rule.step_ratio * (near - far)
+        && step >= rule.min_step_px.max(rule.min_step_fraction * near)
+        && behind >= rule.min_depth_halfwidths * half_width)
+        .then_some(labels)
+}
+
+fn column_span(pixels: &[(u32, u32)]) -> f64 {
+    let (lo, hi) = pixels
+        .iter()
+        .fold((u32::MAX, 0), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
+    f64::from(hi.saturating_sub(lo) + 1)
+}
+
+/// Block matching: each pixel's shift into the other panorama (sub-pixel), or `None` where the
+/// match is not unique. Costs are mean absolute luminance differences over a square window,
+/// from an integral image of the region per shift.
+fn pixel_shifts(
+    pixels: &Component,
+    partner: &Partner,
+    max_shift: usize,
+    radius: usize,
+) -> Vec<Option<f32>> {
+    let col_min = pixels.iter().map(|p| p.0 as usize).min().unwrap_or(0);
+    let col_max = pixels.iter().map(|p| p.0 as usize).max().unwrap_or(0);
+    let row_min = pixels.iter().map(|p| p.1 as usize).min().unwrap_or(0);
+    let row_max = pixels.iter().map(|p| p.1 as usize).max().unwrap_or(0);
+    // Region: the bounding box grown by the window; columns unwrapped from `x0`.
+    let x0 = col_min as isize - radius as isize;
+    let rw = col_max - col_min + 1 + 2 * radius;
+    let y0 = row_min.saturating_sub(radius);
+    let rh = (row_max + radius).min(partner.rows - 1) - y0 + 1;
+    let shifts = max_shift + 1;
+    // The other panorama's rows cover the region at every shift: shift `s` starts at
+    // `s` (direction +1) or `max_shift − s` (direction −1).
+    let ow = rw + max_shift;
+    let ox0 = if partner.direction > 0 {
+        x0
+    } else {
+        x0 - max_shift as isize
+    };
+    let w = partner.width as isize;
+    let read = |img: &[u16], y: usize, x: isize| {
+        i32::from(img[y * partner.width + x.rem_euclid(w) as usize])
+    };
+    let own: Vec<i32> = (0..rh)
+        .flat_map(|y| (0..rw).map(move |x| (y, x)))
+        .map(|(y, x)| read(partner.own, y0 + y, x0 + x as isize))
+        .collect();
+    let other: Vec<i32> = (0..rh)
+        .flat_map(|y| (0..ow).map(move |x| (y, x)))
+        .map(|(y, x)| read(partner.other, y0 + y, ox0 + x as isize))
+        .collect();
+    let windows: Vec<(usize, usize, usize, usize, f32)> = pixels
+        .iter()
+        .map(|&(col, row)| {
+            let cx = col as usize - col_min + radius;
+            let cy = row as usize - y0;
+            let (ya, yb) = (cy.saturating_sub(radius), (cy + radius + 1).min(rh));
+            let (xa, xb) = (cx - radius, cx + radius + 1);
+            (xa, xb, ya, yb, 1.0 / ((xb - xa) * (yb - ya)) as f32)
+        })
+        .collect();
+    let mut costs = vec![0f32; pixels.len() * shifts];
+    let stride = rw + 1;
+    let mut integral = vec![0i32; (rh + 1) * stride];
+    for s in 0..shifts {
+        let start = if partner.direction > 0 {
+            s
+        } else {
+            max_shift - s
+        };
+        for y in 0..rh {
+            let a = &own[y * rw..(y + 1) * rw];
+            let b = &other[y * ow + start..y * ow + start + rw];
+            let mut run = 0;
+            for (x, (p, q)) in a.iter().zip(b).enumerate() {
+                run += (p - q).abs();
+                integral[(y + 1) * stride + x + 1] = integral[y * stride + x + 1] + run;
+            }
+        }
+        for (k, &(xa, xb, ya, yb, scale)) in windows.iter().enumerate() {
+            let sum = integral[yb * stride + xb]
+                - integral[ya * stride + xb]
+                - integral[yb * stride + xa]
+                + integral[ya * stride + xa];
+            costs[k * shifts + s] = sum as f32 * scale;
+        }
+    }
+    costs.chunks_exact(shifts).map(unique_minimum).collect()
+}
+
+/// The sub-pixel position of the minimum of `cost`, if it is clearly below every cost two or
+/// more shifts away (a textureless or repetitive window matches many shifts alike).
+fn unique_minimum(cost: &[f32]) -> Option<f32> {
+    let (best, &low) = cost.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
+    let outside = |range: &[f32]| range.iter().copied().fold(f32::INFINITY, f32::min);
+    let rival =
+        outside(&cost[..best.saturating_sub(1)]).min(outside(cost.get(best + 2..).unwrap_or(&[])));
+    // Costs are mean absolute luminance differences (0–765); a few units is noise.
+    if rival < 1.3 * low + 6.0 {
+        return None;
+    }
+    let refined = match (best.checked_sub(1).map(|i| cost[i]), cost.get(best + 1)) {
+        (Some(a), Some(&c)) if a - 2.0 * low + c > 0.0 => 0.5 * (a - c) / (a - 2.0 * low + c),
+        _ => 0.0,
+    };
+    Some(best as f32 + refined)
+}
+
+/// The threshold splitting sorted `values` into two groups of least within-group variance
+/// (Otsu), and the size of the lower group.
+fn two_groups(sorted: &[f32]) -> Option<(f32, usize)> {
+    let n = sorted.len();
+    let total: f64 = sorted.iter().map(|&v| f64::from(v)).sum();
+    let mut below = 0.0;
+    let mut best: Option<(f64, usize)> = None;
+    for k in 1..n {
+        below += f64::from(sorted[k - 1]);
+        let (m1, m2) = (below / k as f64, (total - below) / (n - k) as f64);
+        let between = k as f64 * (n - k) as f64 * (m2 - m1).powi(2);
+        if best.is_none_or(|(b, _)| between > b) {
+            best = Some((between, k));
+        }
+    }
+    let (_, k) = best?;
+    Some((0.5 * (sorted[k - 1] + sorted[k]), k))
+}
+
+/// The four neighbours of a pixel that belong to the blob.
+fn neighbours<'a>(
+    (col, row): (u32, u32),
+    index: &'a PixelIndex,
+) -> impl Iterator<Item = usize> + 'a {
+    [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)]
+        .into_iter()
+        .filter_map(move |(dc, dr)| index.get(i64::from(col) + dc, i64::from(row) + dr))
+}
+
+/// Nearer (`true`) or farther for every pixel: reliable pixels by their shift, the others
+/// taking the label of the nearest reliable pixel through the blob (breadth first).
+fn fill_labels(
+    pixels: &Component,
+    index: &PixelIndex,
+    shifts: &[Option<f32>],
+    threshold: f32,
+) -> Vec<bool> {
+    let mut label: Vec<Option<bool>> = shifts.iter().map(|s| s.map(|s| s > threshold)).collect();
+    let mut queue: VecDeque<usize> = (0..pixels.len()).filter(|&k| label[k].is_some()).collect();
+    while let Some(k) = queue.pop_front() {
+        for j in neighbours(pixels[k], index) {
+            if label[j].is_none() {
+                label[j] = label[k];
+                queue.push_back(j);
+            }
+        }
+    }
+    label.into_iter().map(|l| l.unwrap_or(true)).collect()
+}
+
+/// Flips the label of every 4-connected run of one label smaller than `min_fragment` pixels:
+/// stray windows along an edge, not a rock.
+fn absorb_fragments(
+    pixels: &Component,
+    index: &PixelIndex,
+    labels: &mut [bool],
+    min_fragment: usize,
+) {
+    let mut seen = vec![false; pixels.len()];
+    for start in 0..pixels.len() {
+        if seen[start] {
+            continue;
+        }
+        seen[start] = true;
+        let mut fragment = vec![start];
+        let mut next = 0;
+        while next < fragment.len() {
+            let k = fragment[next];
+            next += 1;
+            for j in neighbours(pixels[k], index) {
+                if !seen[j] && labels[j] == labels[start] {
+                    seen[j] = true;
+                    fragment.push(j);
+                }
+            }
+        }
+        if fragment.len() < min_fragment {
+            for k in fragment {
+                labels[k] = !labels[k];
+            }
+        }
+    }
+}
+
+/// The median shift difference of reliable pixels a window apart across the border between
+/// the two groups, if enough such pairs exist: a step at an occluding edge, where one rock's
+/// sloping face differs little over so short a distance.
+fn border_step(
+    pixels: &Component,
+    index: &PixelIndex,
+    shifts: &[Option<f32>],
+    labels: &[bool],
+    radius: usize,
+) -> Option<f32> {
+    let gap = 2 * radius as i64 + 1;
+    let mut across = Vec::new();
+    for (k, &(col, row)) in pixels.iter().enumerate() {
+        let Some(s) = shifts[k] else { continue };
+        let (col, row) = (i64::from(col), i64::from(row));
+        for (c, r) in [(col + gap, row), (col, row + gap)] {
+            if let Some(j) = index.get(c, r) {
+                if let (Some(t), true) = (shifts[j], labels[j] != labels[k]) {
+                    // Nearer side minus farther side.
+                    across.push(if labels[k] { s - t } else { t - s });
+                }
+            }
+        }
+    }
+    if across.len() < 5 {
+        return None;
+    }
+    let mid = across.len() / 2;
+    Some(*across.select_nth_unstable_by(mid, f32::total_cmp).1)
+}
