@@ -3,7 +3,8 @@
 //! measured figures less a margin (`qrm-bench --detect DIR` gives full-set numbers). Blobs
 //! of touching rocks are cut; pieces that may be partly hidden behind a nearer rock, and
 //! notched blobs too shallow to cut, are flagged ambiguous and not counted as found: that is
-//! the main loss of recall in the clustered Mars Yard, the price of sound bearings.
+//! the main loss of recall in the clustered Mars Yard, the price of sound bearings. With the
+//! right panorama, blobs of a nearer and a farther rock are also separated by parallax.
 
 use qrm::calib::Calibration;
 use qrm::dataset::{visible_rocks, Counts, Preset, Truth};
@@ -58,6 +59,70 @@ fn check(score: &Score, precision: f64, recall: f64) {
         score.outside_bound * 10 <= score.found,
         "{} found rocks outside 1 px + 0.3 × width",
         score.outside_bound
+    );
+}
+
+/// Scores of `preset`'s `stations` detected alone and with the right panorama, every
+/// detection counted (ambiguous ones too, as `pipeline run`'s evaluation does): parallax
+/// separation adds pieces that may be partly hidden, which the plain score leaves out.
+fn mono_and_stereo(preset: Preset, stations: &[usize]) -> (Score, Score) {
+    let calib = calibration();
+    let layout = preset.layout(7, Counts::default());
+    let world = World::generate(7, &layout.rocks);
+    let settings = DetectorSettings::default();
+    let (mut mono, mut stereo) = (Score::default(), Score::default());
+    let counted = |found: Vec<qrm::detection::Detection>| {
+        found
+            .into_iter()
+            .map(|d| qrm::detection::Detection {
+                ambiguous: false,
+                ..d
+            })
+            .collect::<Vec<_>>()
+    };
+    for &k in stations {
+        let pose = layout.stations[k];
+        let left = render(&world, &calib, pose, Eye::Left);
+        let truth = visible_rocks(&world, &calib, pose, Eye::Left, &left);
+        let left = image::RgbImage::from_raw(left.width, left.height, left.rgb).unwrap();
+        let right = render(&world, &calib, pose, Eye::Right);
+        let right = image::RgbImage::from_raw(right.width, right.height, right.rgb).unwrap();
+        let alone = counted(detect(&left, None, &calib, &settings));
+        let paired = counted(detect(&left, Some(&right), &calib, &settings));
+        mono.add(&alone, &truth, &calib, &settings);
+        stereo.add(&paired, &truth, &calib, &settings);
+    }
+    (mono, stereo)
+}
+
+/// In the clustered Mars Yard most missed rocks are merged with a nearer one of the same tint;
+/// the right panorama separates many of them without costing precision.
+#[test]
+fn parallax_separates_merged_rocks() {
+    let (mono, stereo) = mono_and_stereo(Preset::Marsyard, &[0, 17, 33]);
+    for (name, s) in [("mono", &mono), ("stereo", &stereo)] {
+        println!(
+            "{name}: {} detectable, {} found, {} false, {} splits, {} merged: precision {:.3} recall {:.3}",
+            s.detectable, s.found, s.false_alarms, s.splits, s.merged, s.precision(), s.recall()
+        );
+    }
+    // Measured: 75 → 81 found, 11 → 5 merged, precision 0.938 → 0.976.
+    assert!(
+        stereo.found >= mono.found + 4,
+        "{} vs {} found",
+        stereo.found,
+        mono.found
+    );
+    assert!(
+        stereo.merged + 4 <= mono.merged,
+        "{} vs {} merged",
+        stereo.merged,
+        mono.merged
+    );
+    assert!(
+        stereo.precision() >= 0.95,
+        "precision {}",
+        stereo.precision()
     );
 }
 

@@ -412,3 +412,192 @@ fn border_step(
     let mid = across.len() / 2;
     Some(*across.select_nth_unstable_by(mid, f32::total_cmp).1)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const WIDTH: usize = 300;
+    const ROWS: usize = 90;
+    /// The full-resolution panorama's column width and the default 0.3 m baseline.
+    const COLUMN_WIDTH: f64 = std::f64::consts::TAU / 4096.0;
+    const BASELINE: f64 = 0.3;
+
+    /// Smooth random texture of one surface: bilinear value noise on 3-pixel cells.
+    fn texture(surface: u32, x: f64, y: f64) -> f64 {
+        let hash = |i: i64, j: i64| {
+            let mut h = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                ^ (j as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+                ^ u64::from(surface).wrapping_mul(0x1656_67B1_9E37_79F9);
+            h ^= h >> 29;
+            h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            h ^= h >> 32;
+            (h % 1000) as f64 / 1000.0
+        };
+        let (u, v) = (x / 3.0, y / 3.0);
+        let (i, j) = (u.floor() as i64, v.floor() as i64);
+        let (fu, fv) = (u - i as f64, v - j as f64);
+        let top = hash(i, j) * (1.0 - fu) + hash(i + 1, j) * fu;
+        let bottom = hash(i, j + 1) * (1.0 - fu) + hash(i + 1, j + 1) * fu;
+        150.0 + 300.0 * (top * (1.0 - fv) + bottom * fv)
+    }
+
+    /// A surface of the scene: which own-image pixels it covers and its shift at each column.
+    struct Surface {
+        id: u32,
+        covers: Box<dyn Fn(f64, f64) -> bool>,
+        shift: Box<dyn Fn(f64) -> f64>,
+    }
+
+    /// Both panoramas of `surfaces` (back to front) over ground shifted by 4 columns, the
+    /// other camera seeing each point `shift` columns to the right; and the own pixels of
+    /// every surface but the ground.
+    fn scene(surfaces: &[Surface]) -> (Vec<u16>, Vec<u16>, Component) {
+        let (mut own, mut other) = (vec![0u16; WIDTH * ROWS], vec![0u16; WIDTH * ROWS]);
+        let mut pixels = Component::new();
+        for y in 0..ROWS {
+            for x in 0..WIDTH {
+                let (fx, fy) = (x as f64, y as f64);
+                let front = surfaces.iter().rev().find(|s| (s.covers)(fx, fy));
+                own[y * WIDTH + x] = match front {
+                    Some(s) => {
+                        pixels.push((x as u32, y as u32));
+                        texture(s.id, fx, fy) as u16
+                    }
+                    None => texture(0, fx, fy) as u16,
+                };
+                // The point seen at column x by the other camera: solve x = u + shift(u).
+                let seen = surfaces.iter().rev().find_map(|s| {
+                    let mut u = fx - (s.shift)(fx);
+                    for _ in 0..20 {
+                        u = fx - (s.shift)(u);
+                    }
+                    (s.covers)(u.round(), fy).then(|| texture(s.id, u, fy))
+                });
+                other[y * WIDTH + x] = seen.unwrap_or_else(|| texture(0, fx - 4.0, fy)) as u16;
+            }
+        }
+        (own, other, pixels)
+    }
+
+    fn partner<'a>(own: &'a [u16], other: &'a [u16]) -> Partner<'a> {
+        Partner {
+            own,
+            other,
+            width: WIDTH,
+            rows: ROWS,
+            direction: 1,
+            column_width: COLUMN_WIDTH,
+            baseline_m: BASELINE,
+        }
+    }
+
+    fn rule() -> ParallaxRule {
+        crate::detection::DetectorSettings::default().parallax
+    }
+
+    fn ellipse(cx: f64, cy: f64, a: f64, b: f64) -> Box<dyn Fn(f64, f64) -> bool> {
+        Box::new(move |x, y| ((x - cx) / a).powi(2) + ((y - cy) / b).powi(2) <= 1.0)
+    }
+
+    /// A rock at 19.6 m (shift 10) seen above and behind one at 12.2 m (shift 16): two layers,
+    /// the farther one flagged, each holding (nearly) only its own rock's pixels.
+    #[test]
+    fn a_farther_rock_over_a_nearer_one_is_separated() {
+        let far = Surface {
+            id: 1,
+            covers: ellipse(150.0, 35.0, 40.0, 25.0),
+            shift: Box::new(|_| 10.0),
+        };
+        let near = Surface {
+            id: 2,
+            covers: ellipse(140.0, 62.0, 45.0, 22.0),
+            shift: Box::new(|_| 16.0),
+        };
+        let near_covers = ellipse(140.0, 62.0, 45.0, 22.0);
+        let (own, other, pixels) = scene(&[far, near]);
+        let layers = layers(pixels, &partner(&own, &other), 25, rule());
+        assert_eq!(layers.len(), 2, "{} layers", layers.len());
+        for layer in &layers {
+            let wrong = layer
+                .pixels
+                .iter()
+                .filter(|&&(x, y)| near_covers(f64::from(x), f64::from(y)) == layer.farther)
+                .count();
+            assert!(
+                wrong * 20 < layer.pixels.len(),
+                "{wrong} of {} pixels in the wrong layer (farther: {})",
+                layer.pixels.len(),
+                layer.farther
+            );
+        }
+        assert_eq!(layers.iter().filter(|l| l.farther).count(), 1);
+    }
+
+    /// One rock whose round face curves back from 17 columns of shift in its middle (11.5 m)
+    /// to 15 at its sides, steeply near them as a sphere's does: no step, so one layer.
+    #[test]
+    fn one_rocks_curved_face_stays_whole() {
+        let rock = Surface {
+            id: 1,
+            covers: ellipse(150.0, 45.0, 50.0, 30.0),
+            shift: Box::new(|x| 15.0 + 2.0 * (1.0 - ((x - 150.0) / 50.0).powi(2)).max(0.0).sqrt()),
+        };
+        let (own, other, pixels) = scene(&[rock]);
+        let n = pixels.len();
+        let layers = layers(pixels, &partner(&own, &other), 25, rule());
+        assert_eq!(layers.len(), 1);
+        assert_eq!(layers[0].pixels.len(), n);
+        assert!(!layers[0].farther);
+    }
+
+    /// Two rocks at the same range, side by side: nothing for parallax to separate (the notch
+    /// rule cuts them).
+    #[test]
+    fn rocks_at_one_range_stay_together() {
+        let left = Surface {
+            id: 1,
+            covers: ellipse(110.0, 50.0, 35.0, 25.0),
+            shift: Box::new(|_| 15.0),
+        };
+        let right = Surface {
+            id: 2,
+            covers: ellipse(170.0, 52.0, 35.0, 25.0),
+            shift: Box::new(|_| 15.0),
+        };
+        let (own, other, pixels) = scene(&[left, right]);
+        assert_eq!(layers(pixels, &partner(&own, &other), 25, rule()).len(), 1);
+    }
+
+    /// A lump on top of a wide rock, 0.75 m behind its face at 9.8 m: a step, but less than
+    /// the rock's half-width (0.9 m) behind it, so one rock's shape, not two rocks.
+    #[test]
+    fn a_lump_closer_than_the_half_width_stays_whole() {
+        let lump = Surface {
+            id: 1,
+            covers: ellipse(150.0, 30.0, 30.0, 18.0),
+            shift: Box::new(|_| 18.6),
+        };
+        let body = Surface {
+            id: 2,
+            covers: ellipse(150.0, 60.0, 60.0, 22.0),
+            shift: Box::new(|_| 20.0),
+        };
+        let (own, other, pixels) = scene(&[lump, body]);
+        let whole = layers(pixels.clone(), &partner(&own, &other), 28, rule());
+        assert_eq!(whole.len(), 1);
+        let loose = ParallaxRule {
+            min_depth_halfwidths: 0.0,
+            ..rule()
+        };
+        assert_eq!(layers(pixels, &partner(&own, &other), 28, loose).len(), 2);
+    }
+
+    #[test]
+    fn unique_minimum_refines_and_rejects_flat_costs() {
+        let cost = [50.0, 40.0, 10.0, 20.0, 45.0, 60.0];
+        let s = unique_minimum(&cost).unwrap();
+        assert!(s > 2.0 && s < 2.5, "{s}");
+        assert_eq!(unique_minimum(&[30.0, 29.0, 28.0, 29.0, 30.0]), None);
+    }
+}
