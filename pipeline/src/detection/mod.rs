@@ -17,7 +17,7 @@ mod split;
 use crate::calib::Calibration;
 use components::{blob_of, label_wrapped, Blob};
 use kornia_image::{Image, ImageSize};
-pub use parallax::ParallaxRule;
+pub use parallax::{ParallaxRule, Separation};
 pub use score::{detectable, median_and_max, Score};
 use serde::{Deserialize, Serialize};
 
@@ -103,6 +103,9 @@ pub struct Detection {
     /// May be several rocks (its bottom edge is notched, but too shallowly to cut), or only the
     /// visible part of a rock cut from a nearer one in front of it: do not use its bearing.
     pub ambiguous: bool,
+    /// Whether parallax separated this blob from another part, and which part it is.
+    #[serde(default)]
+    pub separation: Separation,
 }
 
 /// Statistics that change little with viewpoint, for associating a rock across panoramas.
@@ -207,24 +210,27 @@ pub fn detect(
             }
             None => vec![parallax::Layer {
                 pixels: c,
-                farther: false,
+                part: Separation::Whole,
             }],
         })
         .flat_map(|layer| {
             // A farther layer's bottom edge is the nearer rock's outline, notched where that
             // outline rises: the notch rule would cut the farther rock in two.
-            if layer.farther {
+            let pieces = if layer.part == Separation::Farther {
                 vec![split::Piece {
                     pixels: layer.pixels,
                     ambiguous: true,
                 }]
             } else {
                 split::split(layer.pixels, rule)
-            }
+            };
+            pieces.into_iter().map(move |piece| (piece, layer.part))
         })
-        .filter_map(|piece| {
+        .filter_map(|(piece, part)| {
             let blob = blob_of(&piece.pixels, w, &sample);
-            accept(blob, piece.ambiguous, top, calib, settings)
+            let mut detection = accept(blob, piece.ambiguous, top, calib, settings)?;
+            detection.separation = part;
+            Some(detection)
         })
         .collect();
     detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
@@ -378,6 +384,7 @@ fn accept(
         contact_row,
         appearance,
         ambiguous,
+        separation: Separation::Whole,
     })
 }
 

@@ -60,10 +60,24 @@ pub struct ParallaxRule {
     pub sliver_fraction: f32,
 }
 
-/// A connected part of a blob at one range: `farther` if some nearer rock of the blob may hide part of it.
+/// Whether a detection's blob was separated by parallax, and which part it is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Separation {
+    /// Not separated.
+    #[default]
+    Whole,
+    /// In front of the farther part(s) it was separated from: its outline against them is its
+    /// own occluding edge, so touching them does not make its centroid doubtful.
+    Nearer,
+    /// Behind a nearer part, which may hide some of it (its foot at least).
+    Farther,
+}
+
+/// A connected part of a blob at one range.
 pub(super) struct Layer {
     pub pixels: Component,
-    pub farther: bool,
+    pub part: Separation,
 }
 
 /// The layers of `pixels` (unwrapped columns); one layer if the blob is at one range.
@@ -78,13 +92,13 @@ pub(super) fn layers(
     if pixels.len() < rule.min_pixels || max_shift < 2 {
         return vec![Layer {
             pixels,
-            farther: false,
+            part: Separation::Whole,
         }];
     }
     let shifts = pixel_shifts(&pixels, partner, max_shift, rule.radius);
     let mut out = Vec::new();
-    let mut pending = vec![(pixels, shifts, false, 0)];
-    while let Some((pixels, shifts, farther, depth)) = pending.pop() {
+    let mut pending = vec![(pixels, shifts, Separation::Whole, 0)];
+    while let Some((pixels, shifts, part, depth)) = pending.pop() {
         let labels = if depth < 2 {
             separate(&pixels, &shifts, partner, rule)
         } else {
@@ -92,7 +106,7 @@ pub(super) fn layers(
         };
         let Some(labels) = labels else {
             if depth == 0 {
-                out.push(Layer { pixels, farther });
+                out.push(Layer { pixels, part });
             } else {
                 // A separated layer may come apart; its slivers (window-sized runs along the
                 // other layer's edge) are dropped rather than reported as rocks.
@@ -104,7 +118,7 @@ pub(super) fn layers(
                     parts
                         .into_iter()
                         .filter(|p| p.len() >= keep)
-                        .map(|pixels| Layer { pixels, farther }),
+                        .map(|pixels| Layer { pixels, part }),
                 );
             }
             continue;
@@ -115,8 +129,13 @@ pub(super) fn layers(
             side.0.push(p);
             side.1.push(s);
         }
-        pending.push((near.0, near.1, farther, depth + 1));
-        pending.push((far.0, far.1, true, depth + 1));
+        let nearer = if part == Separation::Farther {
+            Separation::Farther
+        } else {
+            Separation::Nearer
+        };
+        pending.push((near.0, near.1, nearer, depth + 1));
+        pending.push((far.0, far.1, Separation::Farther, depth + 1));
     }
     out
 }
@@ -522,16 +541,19 @@ mod tests {
             let wrong = layer
                 .pixels
                 .iter()
-                .filter(|&&(x, y)| near_covers(f64::from(x), f64::from(y)) == layer.farther)
+                .filter(|&&(x, y)| {
+                    near_covers(f64::from(x), f64::from(y)) == (layer.part == Separation::Farther)
+                })
                 .count();
             assert!(
                 wrong * 20 < layer.pixels.len(),
-                "{wrong} of {} pixels in the wrong layer (farther: {})",
+                "{wrong} of {} pixels in the wrong layer ({:?})",
                 layer.pixels.len(),
-                layer.farther
+                layer.part
             );
         }
-        assert_eq!(layers.iter().filter(|l| l.farther).count(), 1);
+        let parts: Vec<Separation> = layers.iter().map(|l| l.part).collect();
+        assert!(parts.contains(&Separation::Nearer) && parts.contains(&Separation::Farther));
     }
 
     /// One rock whose round face curves back from 17 columns of shift in its middle (11.5 m)
@@ -548,7 +570,7 @@ mod tests {
         let layers = layers(pixels, &partner(&own, &other), 25, rule());
         assert_eq!(layers.len(), 1);
         assert_eq!(layers[0].pixels.len(), n);
-        assert!(!layers[0].farther);
+        assert_eq!(layers[0].part, Separation::Whole);
     }
 
     /// Two rocks at the same range, side by side: nothing for parallax to separate (the notch

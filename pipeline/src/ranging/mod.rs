@@ -20,7 +20,7 @@ pub use interval::RangeInterval;
 pub use stereo::match_stereo;
 
 use crate::calib::Calibration;
-use crate::detection::Detection;
+use crate::detection::{Detection, Separation};
 use crate::measurement::{Bearing, RangeOrder};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
@@ -221,11 +221,14 @@ fn ground_cue(
 
 /// Whether detection `index` touches another one side by side (columns within two of each
 /// other, rows overlapping): the two may be pieces of one rock, or two rocks cut apart where
-/// they touch, and either way its centroid may be far from its rock's centre.
+/// they touch, and either way its centroid may be far from its rock's centre. The nearer part
+/// of a blob separated by parallax is not doubted for touching a farther part: the edge
+/// between them is its own outline.
 pub fn touches_neighbour(index: usize, all: &[Detection], width: u32) -> bool {
     let me = &all[index];
     all.iter().enumerate().any(|(j, other)| {
         j != index
+            && !(me.separation == Separation::Nearer && other.separation == Separation::Farther)
             && columns_overlap(me.bbox, other.bbox, 2, width)
             && other.bbox[1] <= me.bbox[3]
             && me.bbox[1] <= other.bbox[3]
