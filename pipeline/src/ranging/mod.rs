@@ -323,6 +323,52 @@ fn azimuth_difference(a: f64, b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::detection::Appearance;
+
+    fn blob(bbox: [u32; 4], separation: Separation) -> Detection {
+        Detection {
+            centroid: [
+                f64::from(bbox[0] + bbox[2]) / 2.0,
+                f64::from(bbox[1] + bbox[3]) / 2.0,
+            ],
+            bbox,
+            pixels: 100,
+            contact_row: f64::from(bbox[3] + 1),
+            appearance: Appearance {
+                colour: [0.4, 0.33, 0.27],
+                brightness: 0.8,
+                texture: 0.1,
+                dark_fraction: 0.2,
+            },
+            ambiguous: separation == Separation::Farther,
+            separation,
+        }
+    }
+
+    /// Two blobs side by side doubt each other; the nearer part of a parallax separation is not
+    /// doubted for touching its farther part, though the farther part still is, and the nearer
+    /// part still is for touching anything else.
+    #[test]
+    fn touching_doubts_all_but_a_nearer_part_against_a_farther_one() {
+        let width = 4096;
+        let whole = [
+            blob([100, 50, 120, 70], Separation::Whole),
+            blob([121, 52, 140, 72], Separation::Whole),
+        ];
+        assert!(touches_neighbour(0, &whole, width) && touches_neighbour(1, &whole, width));
+        let separated = [
+            blob([100, 60, 140, 80], Separation::Nearer),
+            blob([110, 40, 135, 66], Separation::Farther),
+        ];
+        assert!(!touches_neighbour(0, &separated, width));
+        assert!(touches_neighbour(1, &separated, width));
+        let crowded = [
+            separated[0].clone(),
+            separated[1].clone(),
+            blob([141, 62, 160, 80], Separation::Whole),
+        ];
+        assert!(touches_neighbour(0, &crowded, width));
+    }
 
     #[test]
     fn fusion_intersects_and_flags_conflicts() {
