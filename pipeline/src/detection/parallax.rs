@@ -515,6 +515,15 @@ mod tests {
         crate::detection::DetectorSettings::default().parallax
     }
 
+    /// A surface seen shifted by the same `shift` everywhere (a rock face at one range).
+    fn at_shift(id: u32, covers: Box<dyn Fn(f64, f64) -> bool>, shift: f64) -> Surface {
+        Surface {
+            id,
+            covers,
+            shift: Box::new(move |_| shift),
+        }
+    }
+
     fn ellipse(cx: f64, cy: f64, a: f64, b: f64) -> Box<dyn Fn(f64, f64) -> bool> {
         Box::new(move |x, y| ((x - cx) / a).powi(2) + ((y - cy) / b).powi(2) <= 1.0)
     }
@@ -523,16 +532,8 @@ mod tests {
     /// the farther one flagged, each holding (nearly) only its own rock's pixels.
     #[test]
     fn a_farther_rock_over_a_nearer_one_is_separated() {
-        let far = Surface {
-            id: 1,
-            covers: ellipse(150.0, 35.0, 40.0, 25.0),
-            shift: Box::new(|_| 10.0),
-        };
-        let near = Surface {
-            id: 2,
-            covers: ellipse(140.0, 62.0, 45.0, 22.0),
-            shift: Box::new(|_| 16.0),
-        };
+        let far = at_shift(1, ellipse(150.0, 35.0, 40.0, 25.0), 10.0);
+        let near = at_shift(2, ellipse(140.0, 62.0, 45.0, 22.0), 16.0);
         let near_covers = ellipse(140.0, 62.0, 45.0, 22.0);
         let (own, other, pixels) = scene(&[far, near]);
         let layers = layers(pixels, &partner(&own, &other), 25, rule());
@@ -577,16 +578,8 @@ mod tests {
     /// rule cuts them).
     #[test]
     fn rocks_at_one_range_stay_together() {
-        let left = Surface {
-            id: 1,
-            covers: ellipse(110.0, 50.0, 35.0, 25.0),
-            shift: Box::new(|_| 15.0),
-        };
-        let right = Surface {
-            id: 2,
-            covers: ellipse(170.0, 52.0, 35.0, 25.0),
-            shift: Box::new(|_| 15.0),
-        };
+        let left = at_shift(1, ellipse(110.0, 50.0, 35.0, 25.0), 15.0);
+        let right = at_shift(2, ellipse(170.0, 52.0, 35.0, 25.0), 15.0);
         let (own, other, pixels) = scene(&[left, right]);
         assert_eq!(layers(pixels, &partner(&own, &other), 25, rule()).len(), 1);
     }
@@ -595,16 +588,8 @@ mod tests {
     /// the rock's half-width (0.9 m) behind it, so one rock's shape, not two rocks.
     #[test]
     fn a_lump_closer_than_the_half_width_stays_whole() {
-        let lump = Surface {
-            id: 1,
-            covers: ellipse(150.0, 30.0, 30.0, 18.0),
-            shift: Box::new(|_| 18.6),
-        };
-        let body = Surface {
-            id: 2,
-            covers: ellipse(150.0, 60.0, 60.0, 22.0),
-            shift: Box::new(|_| 20.0),
-        };
+        let lump = at_shift(1, ellipse(150.0, 30.0, 30.0, 18.0), 18.6);
+        let body = at_shift(2, ellipse(150.0, 60.0, 60.0, 22.0), 20.0);
         let (own, other, pixels) = scene(&[lump, body]);
         let whole = layers(pixels.clone(), &partner(&own, &other), 28, rule());
         assert_eq!(whole.len(), 1);
