@@ -74,6 +74,10 @@ pub enum Separation {
     Farther,
 }
 
+/// Most matching costs held for one blob (64 MB): a rock filling the bottom of the panorama
+/// right before the rover is left whole rather than matched over hundreds of shifts.
+const MAX_COSTS: usize = 1 << 24;
+
 /// A connected part of a blob at one range.
 pub(super) struct Layer {
     pub pixels: Component,
@@ -89,7 +93,10 @@ pub(super) fn layers(
     max_shift: usize,
     rule: ParallaxRule,
 ) -> Vec<Layer> {
-    if pixels.len() < rule.min_pixels || max_shift < 2 {
+    if pixels.len() < rule.min_pixels
+        || max_shift < 2
+        || pixels.len() * (max_shift + 1) > MAX_COSTS
+    {
         return vec![Layer {
             pixels,
             part: Separation::Whole,
