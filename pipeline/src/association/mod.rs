@@ -42,6 +42,12 @@ use serde::{Deserialize, Serialize};
 /// Closest look-alike landmarks per detection that seed registration hypotheses.
 const REGISTRATION_SEEDS: usize = 6;
 
+/// A station's only registration is dropped when this many other frames could have confirmed
+/// it and did not. In the three such cases seen on half-resolution surveys (two stations of
+/// marsyard seed 3, one of random seed 5 under an earlier detector), 7–8 look-alike pairs fit
+/// one frame by chance while the other five failed to register, and every pair was wrong.
+const SILENT_FRAMES: usize = 3;
+
 /// Slack of the placement test against a registered frame, metres: generous, since ruling
 /// out the true landmark would make a duplicate.
 const PLACEMENT_SLACK_M: f64 = 1.0;
@@ -120,6 +126,20 @@ pub fn associate<C: Calculus>(
         .iter()
         .filter_map(|frame| Some((frame, register(placed, frame, &alike, &seed)?)))
         .collect();
+    // A station's only registration is a chance fit of look-alikes when several other frames
+    // hold enough of its landmarks to have found the same pairing and none did.
+    let registrations = match registrations.as_slice() {
+        [(only, registration)]
+            if frames
+                .iter()
+                .filter(|f| !std::ptr::eq(*f, *only) && f.could_confirm(registration))
+                .count()
+                >= SILENT_FRAMES =>
+        {
+            Vec::new()
+        }
+        _ => registrations,
+    };
     // Registered correspondences of all frames; a detection or landmark given two different
     // partners by different frames is left out.
     let mut pairs: Vec<(usize, LandmarkId)> = registrations
@@ -494,6 +514,29 @@ mod tests {
         }
         assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
         assert_eq!(decisions[7], Decision::New);
+    }
+
+    #[test]
+    fn a_lone_registration_other_frames_do_not_repeat_anchors_nothing() {
+        // The later frames hold the same landmarks, placed too close together to register.
+        let shrunk = FIELD.map(|p| [0.2 * p[0], 0.2 * p[1]]);
+        let station = station(&FIELD);
+        let two = [frame(&FIELD), frame(&shrunk), frame(&shrunk)];
+        let decisions = associate_station(&station, &two);
+        for (i, decision) in decisions.iter().enumerate() {
+            assert_eq!(*decision, Decision::Matched(i as LandmarkId));
+        }
+        let three = [
+            frame(&FIELD),
+            frame(&shrunk),
+            frame(&shrunk),
+            frame(&shrunk),
+        ];
+        let decisions = associate_station(&station, &three);
+        assert!(
+            decisions.iter().all(|d| !matches!(d, Decision::Matched(_))),
+            "{decisions:?}"
+        );
     }
 
     #[test]

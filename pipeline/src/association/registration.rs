@@ -28,6 +28,17 @@ impl Frame {
     pub fn registrable(&self) -> bool {
         self.landmarks.len() >= MIN_INLIERS
     }
+
+    /// Whether the frame holds enough of `registration`'s landmarks to have found the same
+    /// pairing, had it been right.
+    pub fn could_confirm(&self, registration: &Registration) -> bool {
+        registration
+            .pairs
+            .iter()
+            .filter(|(_, l)| self.landmarks.iter().any(|m| m.0 == *l))
+            .count()
+            >= MIN_INLIERS
+    }
 }
 
 /// The correspondences of the best rigid motion: `(detection, landmark)`, and the motion

@@ -106,6 +106,9 @@ pub struct Detection {
     /// Whether parallax separated this blob from another part, and which part it is.
     #[serde(default)]
     pub separation: Separation,
+    /// The connected blob of the mask this detection was cut from: pieces of one blob share it.
+    #[serde(default)]
+    pub blob: u32,
 }
 
 /// Statistics that change little with viewpoint, for associating a rock across panoramas.
@@ -176,7 +179,7 @@ pub fn detect(
             .collect()
     };
     let bands = right
-        .filter(|r| r.dimensions() == image.dimensions())
+        .filter(|r| r.dimensions() == image.dimensions() && calib.stereo.baseline_m > 0.0)
         .map(|r| (luminance(image), luminance(r)));
     // The right camera sees a point turned towards increasing azimuth.
     let partner = bands.as_ref().map(|(own, other)| parallax::Partner {
@@ -203,17 +206,21 @@ pub fn detect(
     };
     let mut detections: Vec<Detection> = label_wrapped(&mask, w, rows)
         .into_iter()
-        .flat_map(|c| match &partner {
-            Some(partner) => {
-                let shift = max_shift(&c);
-                parallax::layers(c, partner, shift, settings.parallax)
-            }
-            None => vec![parallax::Layer {
-                pixels: c,
-                part: Separation::Whole,
-            }],
+        .enumerate()
+        .flat_map(|(blob, c)| {
+            let layers = match &partner {
+                Some(partner) => {
+                    let shift = max_shift(&c);
+                    parallax::layers(c, partner, shift, settings.parallax)
+                }
+                None => vec![parallax::Layer {
+                    pixels: c,
+                    part: Separation::Whole,
+                }],
+            };
+            layers.into_iter().map(move |layer| (blob as u32, layer))
         })
-        .flat_map(|layer| {
+        .flat_map(|(blob, layer)| {
             // A farther layer's bottom edge is the nearer rock's outline, notched where that
             // outline rises: the notch rule would cut the farther rock in two.
             let pieces = if layer.part == Separation::Farther {
@@ -224,12 +231,15 @@ pub fn detect(
             } else {
                 split::split(layer.pixels, rule)
             };
-            pieces.into_iter().map(move |piece| (piece, layer.part))
+            pieces
+                .into_iter()
+                .map(move |piece| (blob, piece, layer.part))
         })
-        .filter_map(|(piece, part)| {
-            let blob = blob_of(&piece.pixels, w, &sample);
-            let mut detection = accept(blob, piece.ambiguous, top, calib, settings)?;
+        .filter_map(|(blob, piece, part)| {
+            let pixels = blob_of(&piece.pixels, w, &sample);
+            let mut detection = accept(pixels, piece.ambiguous, top, calib, settings)?;
             detection.separation = part;
+            detection.blob = blob;
             Some(detection)
         })
         .collect();
@@ -385,6 +395,7 @@ fn accept(
         appearance,
         ambiguous,
         separation: Separation::Whole,
+        blob: 0,
     })
 }
 

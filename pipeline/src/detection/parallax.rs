@@ -74,9 +74,24 @@ pub enum Separation {
     Farther,
 }
 
-/// Most matching costs held for one blob (64 MB): a rock filling the bottom of the panorama
-/// right before the rover is left whole rather than matched over hundreds of shifts.
+/// Most matching costs held for one blob (64 MB), and most window sums computed for it (about
+/// a tenth of a second): a rock filling the bottom of the panorama right before the rover, or
+/// a sparse blob spread over a wide box, is left whole rather than matched over hundreds of
+/// shifts.
 const MAX_COSTS: usize = 1 << 24;
+const MAX_WORK: usize = 1 << 27;
+
+/// Columns and rows spanned by a non-empty set of pixels.
+fn extent(pixels: &[(u32, u32)]) -> (usize, usize) {
+    let (mut c0, mut r0, mut c1, mut r1) = (u32::MAX, u32::MAX, 0, 0);
+    for &(c, r) in pixels {
+        (c0, r0, c1, r1) = (c0.min(c), r0.min(r), c1.max(c), r1.max(r));
+    }
+    (
+        c1.saturating_sub(c0) as usize + 1,
+        r1.saturating_sub(r0) as usize + 1,
+    )
+}
 
 /// A connected part of a blob at one range.
 pub(super) struct Layer {
@@ -93,9 +108,12 @@ pub(super) fn layers(
     max_shift: usize,
     rule: ParallaxRule,
 ) -> Vec<Layer> {
+    let (cols, rows) = extent(&pixels);
+    let work = (cols + 2 * rule.radius) * (rows + 2 * rule.radius) * (max_shift + 1);
     if pixels.len() < rule.min_pixels
         || max_shift < 2
         || pixels.len() * (max_shift + 1) > MAX_COSTS
+        || work > MAX_WORK
     {
         return vec![Layer {
             pixels,
@@ -279,7 +297,7 @@ fn pixel_shifts(
         .collect();
     let mut costs = vec![0f32; pixels.len() * shifts];
     let stride = rw + 1;
-    let mut integral = vec![0i32; (rh + 1) * stride];
+    let mut integral = vec![0i64; (rh + 1) * stride];
     for s in 0..shifts {
         let start = if partner.direction > 0 {
             s
@@ -291,7 +309,7 @@ fn pixel_shifts(
             let b = &other[y * ow + start..y * ow + start + rw];
             let mut run = 0;
             for (x, (p, q)) in a.iter().zip(b).enumerate() {
-                run += (p - q).abs();
+                run += i64::from((p - q).abs());
                 integral[(y + 1) * stride + x + 1] = integral[y * stride + x + 1] + run;
             }
         }
@@ -310,11 +328,16 @@ fn pixel_shifts(
 /// more shifts away (a textureless or repetitive window matches many shifts alike).
 fn unique_minimum(cost: &[f32]) -> Option<f32> {
     let (best, &low) = cost.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
+    // At the end of the search the surface may lie beyond it.
+    if best + 1 == cost.len() {
+        return None;
+    }
     let outside = |range: &[f32]| range.iter().copied().fold(f32::INFINITY, f32::min);
     let rival =
         outside(&cost[..best.saturating_sub(1)]).min(outside(cost.get(best + 2..).unwrap_or(&[])));
-    // Costs are mean absolute luminance differences (0–765); a few units is noise.
-    if rival < 1.3 * low + 6.0 {
+    // Costs are mean absolute luminance differences (0–765); a few units is noise. With no
+    // shift two or more away there is nothing to be unique against.
+    if !rival.is_finite() || rival < 1.3 * low + 6.0 {
         return None;
     }
     let refined = match (best.checked_sub(1).map(|i| cost[i]), cost.get(best + 1)) {
@@ -343,14 +366,23 @@ fn two_groups(sorted: &[f32]) -> Option<(f32, usize)> {
     Some((0.5 * (sorted[k - 1] + sorted[k]), k))
 }
 
-/// The four neighbours of a pixel that belong to the blob.
+/// The eight neighbours of a pixel that belong to the blob (blobs are 8-connected).
 fn neighbours<'a>(
     (col, row): (u32, u32),
     index: &'a PixelIndex,
 ) -> impl Iterator<Item = usize> + 'a {
-    [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)]
-        .into_iter()
-        .filter_map(move |(dc, dr)| index.get(i64::from(col) + dc, i64::from(row) + dr))
+    [
+        (1i64, 0i64),
+        (-1, 0),
+        (0, 1),
+        (0, -1),
+        (1, 1),
+        (1, -1),
+        (-1, 1),
+        (-1, -1),
+    ]
+    .into_iter()
+    .filter_map(move |(dc, dr)| index.get(i64::from(col) + dc, i64::from(row) + dr))
 }
 
 /// Nearer (`true`) or farther for every pixel: reliable pixels by their shift, the others
@@ -374,7 +406,7 @@ fn fill_labels(
     label.into_iter().map(|l| l.unwrap_or(true)).collect()
 }
 
-/// Flips the label of every 4-connected run of one label smaller than `min_fragment` pixels:
+/// Flips the label of every 8-connected run of one label smaller than `min_fragment` pixels:
 /// stray windows along an edge, not a rock.
 fn absorb_fragments(
     pixels: &Component,
@@ -476,43 +508,45 @@ mod tests {
     }
 
     /// Both panoramas of `surfaces` (back to front) over ground shifted by 4 columns, the
-    /// other camera seeing each point `shift` columns to the right; and the own pixels of
-    /// every surface but the ground.
-    fn scene(surfaces: &[Surface]) -> (Vec<u16>, Vec<u16>, Component) {
+    /// other camera seeing each point `shift` columns towards `direction`, turned by `turn`
+    /// columns (so that a scene may straddle the seam); and the own pixels of every surface but
+    /// the ground, columns unwrapped past the seam as the detector's blobs are.
+    fn scene(surfaces: &[Surface], direction: f64, turn: usize) -> (Vec<u16>, Vec<u16>, Component) {
         let (mut own, mut other) = (vec![0u16; WIDTH * ROWS], vec![0u16; WIDTH * ROWS]);
         let mut pixels = Component::new();
         for y in 0..ROWS {
             for x in 0..WIDTH {
                 let (fx, fy) = (x as f64, y as f64);
+                let at = y * WIDTH + (x + turn) % WIDTH;
                 let front = surfaces.iter().rev().find(|s| (s.covers)(fx, fy));
-                own[y * WIDTH + x] = match front {
+                own[at] = match front {
                     Some(s) => {
-                        pixels.push((x as u32, y as u32));
+                        pixels.push(((x + turn) as u32, y as u32));
                         texture(s.id, fx, fy) as u16
                     }
                     None => texture(0, fx, fy) as u16,
                 };
-                // The point seen at column x by the other camera: solve x = u + shift(u).
+                // The point seen at column x by the other camera: solve x = u ± shift(u).
                 let seen = surfaces.iter().rev().find_map(|s| {
-                    let mut u = fx - (s.shift)(fx);
+                    let mut u = fx - direction * (s.shift)(fx);
                     for _ in 0..20 {
-                        u = fx - (s.shift)(u);
+                        u = fx - direction * (s.shift)(u);
                     }
                     (s.covers)(u.round(), fy).then(|| texture(s.id, u, fy))
                 });
-                other[y * WIDTH + x] = seen.unwrap_or_else(|| texture(0, fx - 4.0, fy)) as u16;
+                other[at] = seen.unwrap_or_else(|| texture(0, fx - direction * 4.0, fy)) as u16;
             }
         }
         (own, other, pixels)
     }
 
-    fn partner<'a>(own: &'a [u16], other: &'a [u16]) -> Partner<'a> {
+    fn partner<'a>(own: &'a [u16], other: &'a [u16], direction: isize) -> Partner<'a> {
         Partner {
             own,
             other,
             width: WIDTH,
             rows: ROWS,
-            direction: 1,
+            direction,
             column_width: COLUMN_WIDTH,
             baseline_m: BASELINE,
         }
@@ -536,32 +570,36 @@ mod tests {
     }
 
     /// A rock at 19.6 m (shift 10) seen above and behind one at 12.2 m (shift 16): two layers,
-    /// the farther one flagged, each holding (nearly) only its own rock's pixels.
+    /// the farther one flagged, each holding (nearly) only its own rock's pixels; whichever way
+    /// the other camera sees points shifted, and across the panorama's seam.
     #[test]
     fn a_farther_rock_over_a_nearer_one_is_separated() {
-        let far = at_shift(1, ellipse(150.0, 35.0, 40.0, 25.0), 10.0);
-        let near = at_shift(2, ellipse(140.0, 62.0, 45.0, 22.0), 16.0);
         let near_covers = ellipse(140.0, 62.0, 45.0, 22.0);
-        let (own, other, pixels) = scene(&[far, near]);
-        let layers = layers(pixels, &partner(&own, &other), 25, rule());
-        assert_eq!(layers.len(), 2, "{} layers", layers.len());
-        for layer in &layers {
-            let wrong = layer
-                .pixels
-                .iter()
-                .filter(|&&(x, y)| {
-                    near_covers(f64::from(x), f64::from(y)) == (layer.part == Separation::Farther)
-                })
-                .count();
-            assert!(
-                wrong * 20 < layer.pixels.len(),
-                "{wrong} of {} pixels in the wrong layer ({:?})",
-                layer.pixels.len(),
-                layer.part
-            );
+        for (direction, turn) in [(1, 0), (-1, 0), (-1, 200)] {
+            let far = at_shift(1, ellipse(150.0, 35.0, 40.0, 25.0), 10.0);
+            let near = at_shift(2, ellipse(140.0, 62.0, 45.0, 22.0), 16.0);
+            let (own, other, pixels) = scene(&[far, near], direction as f64, turn);
+            let layers = layers(pixels, &partner(&own, &other, direction), 25, rule());
+            assert_eq!(layers.len(), 2, "{direction} {turn}");
+            for layer in &layers {
+                let wrong = layer
+                    .pixels
+                    .iter()
+                    .filter(|&&(x, y)| {
+                        let x = f64::from(x) - turn as f64;
+                        near_covers(x, f64::from(y)) == (layer.part == Separation::Farther)
+                    })
+                    .count();
+                assert!(
+                    wrong * 20 < layer.pixels.len(),
+                    "{wrong} of {} pixels in the wrong layer ({:?}; {direction} {turn})",
+                    layer.pixels.len(),
+                    layer.part
+                );
+            }
+            let parts: Vec<Separation> = layers.iter().map(|l| l.part).collect();
+            assert!(parts.contains(&Separation::Nearer) && parts.contains(&Separation::Farther));
         }
-        let parts: Vec<Separation> = layers.iter().map(|l| l.part).collect();
-        assert!(parts.contains(&Separation::Nearer) && parts.contains(&Separation::Farther));
     }
 
     /// One rock whose round face curves back from 17 columns of shift in its middle (11.5 m)
@@ -573,12 +611,21 @@ mod tests {
             covers: ellipse(150.0, 45.0, 50.0, 30.0),
             shift: Box::new(|x| 15.0 + 2.0 * (1.0 - ((x - 150.0) / 50.0).powi(2)).max(0.0).sqrt()),
         };
-        let (own, other, pixels) = scene(&[rock]);
+        let (own, other, pixels) = scene(&[rock], 1.0, 0);
         let n = pixels.len();
-        let layers = layers(pixels, &partner(&own, &other), 25, rule());
-        assert_eq!(layers.len(), 1);
-        assert_eq!(layers[0].pixels.len(), n);
-        assert_eq!(layers[0].part, Separation::Whole);
+        let whole = layers(pixels.clone(), &partner(&own, &other, 1), 25, rule());
+        assert_eq!(whole.len(), 1);
+        assert_eq!(whole[0].pixels.len(), n);
+        assert_eq!(whole[0].part, Separation::Whole);
+        // The step rule alone keeps it whole.
+        let stepless = ParallaxRule {
+            min_depth_halfwidths: 0.0,
+            ..rule()
+        };
+        assert_eq!(
+            layers(pixels, &partner(&own, &other, 1), 25, stepless).len(),
+            1
+        );
     }
 
     /// Two rocks at the same range, side by side: nothing for parallax to separate (the notch
@@ -587,8 +634,11 @@ mod tests {
     fn rocks_at_one_range_stay_together() {
         let left = at_shift(1, ellipse(110.0, 50.0, 35.0, 25.0), 15.0);
         let right = at_shift(2, ellipse(170.0, 52.0, 35.0, 25.0), 15.0);
-        let (own, other, pixels) = scene(&[left, right]);
-        assert_eq!(layers(pixels, &partner(&own, &other), 25, rule()).len(), 1);
+        let (own, other, pixels) = scene(&[left, right], 1.0, 0);
+        assert_eq!(
+            layers(pixels, &partner(&own, &other, 1), 25, rule()).len(),
+            1
+        );
     }
 
     /// A lump on top of a wide rock, 0.75 m behind its face at 9.8 m: a step, but less than
@@ -597,14 +647,17 @@ mod tests {
     fn a_lump_closer_than_the_half_width_stays_whole() {
         let lump = at_shift(1, ellipse(150.0, 30.0, 30.0, 18.0), 18.6);
         let body = at_shift(2, ellipse(150.0, 60.0, 60.0, 22.0), 20.0);
-        let (own, other, pixels) = scene(&[lump, body]);
-        let whole = layers(pixels.clone(), &partner(&own, &other), 28, rule());
+        let (own, other, pixels) = scene(&[lump, body], 1.0, 0);
+        let whole = layers(pixels.clone(), &partner(&own, &other, 1), 28, rule());
         assert_eq!(whole.len(), 1);
         let loose = ParallaxRule {
             min_depth_halfwidths: 0.0,
             ..rule()
         };
-        assert_eq!(layers(pixels, &partner(&own, &other), 28, loose).len(), 2);
+        assert_eq!(
+            layers(pixels, &partner(&own, &other, 1), 28, loose).len(),
+            2
+        );
     }
 
     #[test]
@@ -613,5 +666,15 @@ mod tests {
         let s = unique_minimum(&cost).unwrap();
         assert!(s > 2.0 && s < 2.5, "{s}");
         assert_eq!(unique_minimum(&[30.0, 29.0, 28.0, 29.0, 30.0]), None);
+        assert_eq!(
+            unique_minimum(&[60.0, 40.0, 10.0]),
+            None,
+            "minimum at the search's end"
+        );
+        assert_eq!(
+            unique_minimum(&[60.0, 10.0, 40.0]),
+            None,
+            "no rival two shifts away"
+        );
     }
 }

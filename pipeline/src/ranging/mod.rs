@@ -222,13 +222,15 @@ fn ground_cue(
 /// Whether detection `index` touches another one side by side (columns within two of each
 /// other, rows overlapping): the two may be pieces of one rock, or two rocks cut apart where
 /// they touch, and either way its centroid may be far from its rock's centre. The nearer part
-/// of a blob separated by parallax is not doubted for touching a farther part: the edge
-/// between them is its own outline.
+/// of a blob separated by parallax is not doubted for touching a farther part of the same
+/// blob: the edge between them is its own outline.
 pub fn touches_neighbour(index: usize, all: &[Detection], width: u32) -> bool {
     let me = &all[index];
     all.iter().enumerate().any(|(j, other)| {
         j != index
-            && !(me.separation == Separation::Nearer && other.separation == Separation::Farther)
+            && !(me.separation == Separation::Nearer
+                && other.separation == Separation::Farther
+                && other.blob == me.blob)
             && columns_overlap(me.bbox, other.bbox, 2, width)
             && other.bbox[1] <= me.bbox[3]
             && me.bbox[1] <= other.bbox[3]
@@ -342,12 +344,13 @@ mod tests {
             },
             ambiguous: separation == Separation::Farther,
             separation,
+            blob: 7,
         }
     }
 
     /// Two blobs side by side doubt each other; the nearer part of a parallax separation is not
-    /// doubted for touching its farther part, though the farther part still is, and the nearer
-    /// part still is for touching anything else.
+    /// doubted for touching its own blob's farther part, though the farther part still is, and
+    /// the nearer part still is for touching anything else.
     #[test]
     fn touching_doubts_all_but_a_nearer_part_against_a_farther_one() {
         let width = 4096;
@@ -368,6 +371,17 @@ mod tests {
             blob([141, 62, 160, 80], Separation::Whole),
         ];
         assert!(touches_neighbour(0, &crowded, width));
+        let strangers = [
+            separated[0].clone(),
+            Detection {
+                blob: 8,
+                ..separated[1].clone()
+            },
+        ];
+        assert!(
+            touches_neighbour(0, &strangers, width),
+            "a farther part of another blob"
+        );
     }
 
     #[test]

@@ -9,7 +9,7 @@
 
 use super::{azimuth_difference, SensorModel};
 use crate::calib::Calibration;
-use crate::detection::Detection;
+use crate::detection::{Detection, Separation};
 
 /// For each primary (left) detection, the index of its right-panorama partner, if any.
 pub fn match_stereo(
@@ -37,6 +37,11 @@ pub fn match_stereo(
     let best_left = |j: usize| best_of(cost.iter().map(|row| row[j]).enumerate());
     (0..left.len())
         .map(|i| {
+            // A part of a blob separated by parallax has no counterpart: the right panorama's
+            // blob still holds both rocks, and pairing with it would bend bearing and range.
+            if left[i].separation != Separation::Whole {
+                return None;
+            }
             // The best partner, if it is a doubtful detection, gives no cue: falling back to
             // the runner-up would pair the rock with a neighbour.
             let (j, _) = best_right(i)?;

@@ -61,7 +61,7 @@ pub fn detect_station(
         });
     let start = Instant::now();
     // Only the primary (left) panorama's blobs are separated by parallax: the right one's
-    // detections serve the stereo cue, which takes only lone blobs.
+    // detections only serve the stereo cue, which separated parts do not take.
     let primary_detections = detect(&primary, right.as_ref(), calib, settings);
     let right_detections = right.as_ref().map(|r| detect(r, None, calib, settings));
     detect_seconds += start.elapsed().as_secs_f64();

@@ -8,11 +8,11 @@ use crate::association::{
 };
 use crate::calculus::{Calculus, RelationSet};
 use crate::calib::Calibration;
-use crate::detection::Detection;
+use crate::detection::{Detection, Separation};
 use crate::map::{Hypergraph, LandmarkId, Observation};
 use crate::measurement::{Bearing, Panorama, MAX_BEARING_UNCERTAINTY};
 use crate::neighborhood::estimate;
-use crate::ranging::{self, PrimaryEye, Ranged, SensorModel};
+use crate::ranging::{self, PrimaryEye, RangeInterval, Ranged, SensorModel};
 use crate::simulation::observations;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -164,7 +164,7 @@ impl<C: Calculus> Mapper<C> {
             .iter()
             .map(|&i| Evidence {
                 appearance: station.primary[i].appearance.clone(),
-                width: ranging::width_evidence(&ranged[i], &self.sensor),
+                width: width_of(&station.primary[i], &ranged[i], &self.sensor),
             })
             .collect();
         let placed: Vec<Option<Placed>> = usable.iter().map(|&i| placed(&ranged[i])).collect();
@@ -194,8 +194,12 @@ impl<C: Calculus> Mapper<C> {
                 Decision::HeldBack(candidates) => held.push((k, candidates.clone())),
             }
         }
-        // The size cue, for landmarks whose width earlier stations bounded.
+        // The size cue, for landmarks whose width earlier stations bounded (not for parts of
+        // a blob separated by parallax: see `width_of`).
         for &(k, l) in &fused {
+            if station.primary[usable[k]].separation != Separation::Whole {
+                continue;
+            }
             if let Some(width) = self.gallery.profile(l).and_then(|p| p.width) {
                 ranging::apply_size(&mut ranged[usable[k]], width, &self.sensor);
             }
@@ -230,7 +234,7 @@ impl<C: Calculus> Mapper<C> {
                     self.gallery.observe(
                         landmark,
                         evidence[position].appearance.clone(),
-                        ranging::width_evidence(&ranged[i], &self.sensor),
+                        width_of(&station.primary[i], &ranged[i], &self.sensor),
                     );
                     self.sightings.push((index, i, landmark));
                     record.detections[i].association = match decisions[position] {
@@ -388,6 +392,16 @@ fn stacked(d: &Detection) -> bool {
     let width = f64::from(d.bbox[2] - d.bbox[0] + 1);
     let height = f64::from(d.bbox[3] - d.bbox[1] + 1);
     height > MAX_ASPECT * width
+}
+
+/// The physical width a detection implies for its rock (`ranging::width_evidence`), unless it
+/// is a part of a blob separated by parallax: a false cut of one large rock (its sides read
+/// farther than its middle) leaves a part narrower than the rock, which would bound the
+/// landmark's width too low and put the size cue's ranges too far.
+fn width_of(d: &Detection, ranged: &Ranged, model: &SensorModel) -> Option<RangeInterval> {
+    (d.separation == Separation::Whole)
+        .then(|| ranging::width_evidence(ranged, model))
+        .flatten()
 }
 
 /// Recent stations registered against (a rover moves a few metres between stations: the most
