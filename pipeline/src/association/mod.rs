@@ -411,16 +411,7 @@ mod tests {
     use super::*;
     use crate::edc::Edc;
     use crate::measurement::{Bearing, RangeOrder};
-
-    /// Six rocks around the station, metres apart.
-    const FIELD: [[f64; 2]; 6] = [
-        [3.0, 1.0],
-        [5.0, -2.0],
-        [-4.0, 6.0],
-        [0.5, -7.0],
-        [8.0, 8.0],
-        [-6.0, -3.0],
-    ];
+    use registration::tests::FIELD;
 
     fn look() -> Appearance {
         Appearance {

@@ -281,19 +281,22 @@ fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
+
+    /// Six rocks around a station, metres apart (also the association tests' field).
+    pub(in crate::association) const FIELD: [[f64; 2]; 6] = [
+        [3.0, 1.0],
+        [5.0, -2.0],
+        [-4.0, 6.0],
+        [0.5, -7.0],
+        [8.0, 8.0],
+        [-6.0, -3.0],
+    ];
 
     #[test]
     fn recovers_who_is_who_after_a_rigid_motion() {
-        let field = [
-            [3.0, 1.0],
-            [5.0, -2.0],
-            [-4.0, 6.0],
-            [0.5, -7.0],
-            [8.0, 8.0],
-            [-6.0, -3.0],
-        ];
+        let field = FIELD;
         let (angle, shift) = (0.7f64, [1.5, -0.8]);
         let frame = Frame {
             landmarks: field

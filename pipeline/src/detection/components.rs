@@ -122,6 +122,14 @@ pub(super) fn blob_of(
     blob
 }
 
+/// `[column_min, row_min, column_max, row_max]` of a set of pixels, if it has any.
+pub(super) fn bounds(pixels: &[(u32, u32)]) -> Option<[u32; 4]> {
+    let (&(c, r), rest) = pixels.split_first()?;
+    Some(rest.iter().fold([c, r, c, r], |[c0, r0, c1, r1], &(c, r)| {
+        [c0.min(c), r0.min(r), c1.max(c), r1.max(r)]
+    }))
+}
+
 /// Where each pixel of a set sits in it, by (column, row): a dense grid over the set's
 /// bounding box, cheaper than hashing for blob-sized sets.
 pub(super) struct PixelIndex {
@@ -134,14 +142,9 @@ pub(super) struct PixelIndex {
 
 impl PixelIndex {
     pub fn new(pixels: &[(u32, u32)]) -> PixelIndex {
-        let (mut c0, mut r0, mut c1, mut r1) = (u32::MAX, u32::MAX, 0, 0);
-        for &(c, r) in pixels {
-            (c0, r0, c1, r1) = (c0.min(c), r0.min(r), c1.max(c), r1.max(r));
-        }
-        let (cols, rows) = if pixels.is_empty() {
-            (0, 0)
-        } else {
-            (i64::from(c1 - c0) + 1, i64::from(r1 - r0) + 1)
+        let ([c0, r0, _, _], cols, rows) = match bounds(pixels) {
+            Some(b) => (b, i64::from(b[2] - b[0]) + 1, i64::from(b[3] - b[1]) + 1),
+            None => ([0; 4], 0, 0),
         };
         let mut index = PixelIndex {
             col0: i64::from(c0),

@@ -7,7 +7,7 @@
 //! step (an occluding edge) rather than a slope (one rock's curved face), and far enough apart
 //! in range that two rocks fit, is separated into a nearer and a farther layer.
 
-use super::components::{connected, Component, PixelIndex};
+use super::components::{bounds, connected, Component, PixelIndex};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
@@ -81,18 +81,6 @@ pub enum Separation {
 const MAX_COSTS: usize = 1 << 24;
 const MAX_WORK: usize = 1 << 27;
 
-/// Columns and rows spanned by a non-empty set of pixels.
-fn extent(pixels: &[(u32, u32)]) -> (usize, usize) {
-    let (mut c0, mut r0, mut c1, mut r1) = (u32::MAX, u32::MAX, 0, 0);
-    for &(c, r) in pixels {
-        (c0, r0, c1, r1) = (c0.min(c), r0.min(r), c1.max(c), r1.max(r));
-    }
-    (
-        c1.saturating_sub(c0) as usize + 1,
-        r1.saturating_sub(r0) as usize + 1,
-    )
-}
-
 /// A connected part of a blob at one range.
 pub(super) struct Layer {
     pub pixels: Component,
@@ -108,7 +96,8 @@ pub(super) fn layers(
     max_shift: usize,
     rule: ParallaxRule,
 ) -> Vec<Layer> {
-    let (cols, rows) = extent(&pixels);
+    let [c0, r0, c1, r1] = bounds(&pixels).unwrap_or([0; 4]);
+    let (cols, rows) = ((c1 - c0) as usize + 1, (r1 - r0) as usize + 1);
     let work = (cols + 2 * rule.radius) * (rows + 2 * rule.radius) * (max_shift + 1);
     if pixels.len() < rule.min_pixels
         || max_shift < 2
@@ -240,10 +229,7 @@ fn separate_at(
 }
 
 fn column_span(pixels: &[(u32, u32)]) -> f64 {
-    let (lo, hi) = pixels
-        .iter()
-        .fold((u32::MAX, 0), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
-    f64::from(hi.saturating_sub(lo) + 1)
+    bounds(pixels).map_or(0.0, |[c0, _, c1, _]| f64::from(c1 - c0 + 1))
 }
 
 /// Block matching: each pixel's shift into the other panorama (sub-pixel), or `None` where the
@@ -255,10 +241,7 @@ fn pixel_shifts(
     max_shift: usize,
     radius: usize,
 ) -> Vec<Option<f32>> {
-    let col_min = pixels.iter().map(|p| p.0 as usize).min().unwrap_or(0);
-    let col_max = pixels.iter().map(|p| p.0 as usize).max().unwrap_or(0);
-    let row_min = pixels.iter().map(|p| p.1 as usize).min().unwrap_or(0);
-    let row_max = pixels.iter().map(|p| p.1 as usize).max().unwrap_or(0);
+    let [col_min, row_min, col_max, row_max] = bounds(pixels).unwrap_or([0; 4]).map(|v| v as usize);
     // Region: the bounding box grown by the window; columns unwrapped from `x0`.
     let x0 = col_min as isize - radius as isize;
     let rw = col_max - col_min + 1 + 2 * radius;
@@ -556,6 +539,14 @@ mod tests {
         crate::detection::DetectorSettings::default().parallax
     }
 
+    /// The default rule without its depth test, to show which rule keeps a blob whole.
+    fn without_depth_rule() -> ParallaxRule {
+        ParallaxRule {
+            min_depth_halfwidths: 0.0,
+            ..rule()
+        }
+    }
+
     /// A surface seen shifted by the same `shift` everywhere (a rock face at one range).
     fn at_shift(id: u32, covers: Box<dyn Fn(f64, f64) -> bool>, shift: f64) -> Surface {
         Surface {
@@ -618,12 +609,8 @@ mod tests {
         assert_eq!(whole[0].pixels.len(), n);
         assert_eq!(whole[0].part, Separation::Whole);
         // The step rule alone keeps it whole.
-        let stepless = ParallaxRule {
-            min_depth_halfwidths: 0.0,
-            ..rule()
-        };
         assert_eq!(
-            layers(pixels, &partner(&own, &other, 1), 25, stepless).len(),
+            layers(pixels, &partner(&own, &other, 1), 25, without_depth_rule()).len(),
             1
         );
     }
@@ -650,12 +637,8 @@ mod tests {
         let (own, other, pixels) = scene(&[lump, body], 1.0, 0);
         let whole = layers(pixels.clone(), &partner(&own, &other, 1), 28, rule());
         assert_eq!(whole.len(), 1);
-        let loose = ParallaxRule {
-            min_depth_halfwidths: 0.0,
-            ..rule()
-        };
         assert_eq!(
-            layers(pixels, &partner(&own, &other, 1), 28, loose).len(),
+            layers(pixels, &partner(&own, &other, 1), 28, without_depth_rule()).len(),
             2
         );
     }

@@ -231,10 +231,11 @@ impl<C: Calculus> Mapper<C> {
                 self.next_landmark = fresh;
                 for &(position, landmark) in &fused {
                     let i = usable[position];
+                    // The size cue applied since does not enter the width evidence.
                     self.gallery.observe(
                         landmark,
                         evidence[position].appearance.clone(),
-                        width_of(&station.primary[i], &ranged[i], &self.sensor),
+                        evidence[position].width,
                     );
                     self.sightings.push((index, i, landmark));
                     record.detections[i].association = match decisions[position] {
