@@ -3,15 +3,11 @@
 //! with ranges, left/right disparity with range and baseline — and the files are what the
 //! format promises.
 
-use qrm::calib::Calibration;
-use qrm::dataset::{write_dataset, Counts, Preset, Request, Truth, VisibleRock};
+use qrm_synth::dataset::{write_dataset, Counts, Preset, Request, Truth, VisibleRock};
+use qrm_vision::calib::Calibration;
 
 fn calibration(scale: f64) -> Calibration {
-    let text = include_str!("../calib/default.toml");
-    Calibration::parse(text, "default.toml")
-        .unwrap()
-        .scaled(scale)
-        .unwrap()
+    qrm_synth::default_calibration().scaled(scale).unwrap()
 }
 
 fn render(preset: Preset, stations: usize, stereo: bool, name: &str) -> (Truth, Calibration) {

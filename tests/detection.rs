@@ -6,13 +6,14 @@
 //! the main loss of recall in the clustered Mars Yard, the price of sound bearings. With the
 //! right panorama, blobs of a nearer and a farther rock are also separated by parallax.
 
-use qrm::calib::Calibration;
-use qrm::dataset::{visible_rocks, Counts, Preset, Truth};
-use qrm::detection::{detect, median_and_max, DetectorSettings, Score};
-use qrm::synth::{render, Eye, World};
+use qrm_synth::dataset::{visible_rocks, Counts, Preset, Truth};
+use qrm_synth::detection_score::{median_and_max, Score};
+use qrm_synth::{render, Eye, World};
+use qrm_vision::calib::Calibration;
+use qrm_vision::detection::{detect, DetectorSettings};
 
 fn calibration() -> Calibration {
-    Calibration::parse(include_str!("../calib/default.toml"), "default.toml").unwrap()
+    qrm_synth::default_calibration()
 }
 
 fn score_stations(preset: Preset, stations: &[usize]) -> Score {
@@ -71,10 +72,10 @@ fn mono_and_stereo(preset: Preset, stations: &[usize]) -> (Score, Score) {
     let world = World::generate(7, &layout.rocks);
     let settings = DetectorSettings::default();
     let (mut mono, mut stereo) = (Score::default(), Score::default());
-    let counted = |found: Vec<qrm::detection::Detection>| {
+    let counted = |found: Vec<qrm_vision::detection::Detection>| {
         found
             .into_iter()
-            .map(|d| qrm::detection::Detection {
+            .map(|d| qrm_vision::detection::Detection {
                 ambiguous: false,
                 ..d
             })

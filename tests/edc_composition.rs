@@ -1,12 +1,12 @@
 //! The committed EDC composition table (000 §III-B) against independent evidence: its own
 //! witnesses, the worked example of §III-C, a million random configurations, and regeneration.
 
-use qrm::calculus::{Calculus, CompositionFile, EntryKind, RelationSet};
-use qrm::edc::{classify, Edc, COMPOSITION_TABLE};
-use qrm::feasibility::Settings;
-use qrm::generation::edc_composition_cell;
-use qrm::geometry::Point;
+use qrm_core::calculus::{Calculus, CompositionFile, EntryKind, RelationSet};
+use qrm_core::edc::{classify, Edc, COMPOSITION_TABLE};
+use qrm_core::feasibility::Settings;
+use qrm_core::geometry::Point;
 use qrm_tests::{random_point, rng, Similarity};
+use qrm_tools::edc_composition_cell;
 use rand::Rng;
 use rayon::prelude::*;
 

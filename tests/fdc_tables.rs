@@ -3,11 +3,11 @@
 
 use num_bigint::BigInt;
 use num_rational::BigRational;
-use qrm::calculus::{Calculus, CompositionFile, RelationSet, UnaryFile};
-use qrm::fdc::{classify_exact, Fdc, COMPOSITION_TABLE, UNARY_TABLE};
-use qrm::generation::{fdc_composition, fdc_unary};
-use qrm::geometry::{Point, Point2};
+use qrm_core::calculus::{Calculus, CompositionFile, RelationSet, UnaryFile};
+use qrm_core::fdc::{classify_exact, Fdc, COMPOSITION_TABLE, UNARY_TABLE};
+use qrm_core::geometry::{Point, Point2};
 use qrm_tests::{random_point, rng};
+use qrm_tools::{fdc_composition, fdc_unary};
 use rand::Rng;
 
 type Q = BigRational;

@@ -1,7 +1,7 @@
 //! The feasibility engine on systems with known answers (000 §V), and witness soundness.
 
 use proptest::prelude::*;
-use qrm::feasibility::{BranchAndBound, Linear, Outcome, Problem, Quadratic, Settings};
+use qrm_core::feasibility::{BranchAndBound, Linear, Outcome, Problem, Quadratic, Settings};
 
 fn linear(b: &[f64], c: f64) -> Quadratic {
     Quadratic::from_linear(&Linear { b: b.to_vec(), c })

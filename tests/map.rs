@@ -4,11 +4,11 @@
 //! invariants (order independence, transactions, JSON round trips).
 
 use proptest::prelude::*;
-use qrm::calculus::{Calculus, RelationSet};
-use qrm::edc::Edc;
-use qrm::fdc::Fdc;
-use qrm::geometry::Point;
-use qrm::map::{ContradictionStage, Hypergraph, MapFormatError, Observation};
+use qrm_core::calculus::{Calculus, RelationSet};
+use qrm_core::edc::Edc;
+use qrm_core::fdc::Fdc;
+use qrm_core::geometry::Point;
+use qrm_core::map::{ContradictionStage, Hypergraph, MapFormatError, Observation};
 use qrm_tests::{random_point, rng};
 use rand::seq::SliceRandom;
 use rand::Rng;

@@ -2,11 +2,11 @@
 //! arrangements are never excluded, and everything a dense sample of arrangements consistent
 //! with the observation reaches is in the measured set.
 
-use qrm::calculus::{Calculus, RelationSet};
-use qrm::edc::Edc;
-use qrm::fdc::Fdc;
-use qrm::geometry::Point;
-use qrm::measurement::{Bearing, Panorama, RangeOrder};
+use qrm_core::calculus::{Calculus, RelationSet};
+use qrm_core::edc::Edc;
+use qrm_core::fdc::Fdc;
+use qrm_core::geometry::Point;
+use qrm_core::measurement::{Bearing, Panorama, RangeOrder};
 use qrm_tests::{random_point, rng};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -170,8 +170,8 @@ fn fdc_measurement_is_sound() {
 /// boundary in rounding, which it classifies into both neighbours. That looseness stays small.
 #[test]
 fn sweep_agrees_with_branch_and_bound() {
-    use qrm::feasibility::BranchAndBound;
-    use qrm::measurement::{by_search, by_sweep};
+    use qrm_core::feasibility::BranchAndBound;
+    use qrm_core::measurement::{by_search, by_sweep};
     let engine = BranchAndBound::default();
     let mut rng = rng(21);
     let (mut relations, mut extra) = (0, 0);

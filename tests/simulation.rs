@@ -2,11 +2,11 @@
 //! state, fusion order does not matter, merging maps equals fusing both streams, and the RNG
 //! estimate never prunes a true RNG edge.
 
-use qrm::calculus::Calculus;
-use qrm::edc::Edc;
-use qrm::fdc::Fdc;
-use qrm::map::Hypergraph;
-use qrm::simulation::{observations, run, MonteCarlo, Scenario, Sensor};
+use qrm_core::calculus::Calculus;
+use qrm_core::edc::Edc;
+use qrm_core::fdc::Fdc;
+use qrm_core::map::Hypergraph;
+use qrm_core::simulation::{observations, run, MonteCarlo, Scenario, Sensor};
 use qrm_tests::rng;
 
 fn sound_runs<C: Calculus>(sensor: Sensor, seeds: std::ops::Range<u64>) {
@@ -56,7 +56,11 @@ fn noisy_bearings_within_the_declared_interval_are_sound() {
 
 /// The panoramas of a scenario as observation batches, each measured against an empty map so
 /// that batches do not depend on fusion order.
-fn batches(scenario: &Scenario, sensor: &Sensor, seed: u64) -> Vec<Vec<qrm::map::Observation>> {
+fn batches(
+    scenario: &Scenario,
+    sensor: &Sensor,
+    seed: u64,
+) -> Vec<Vec<qrm_core::map::Observation>> {
     let mut random = rng(seed);
     let empty = Hypergraph::<Edc>::new();
     scenario

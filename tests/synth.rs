@@ -1,13 +1,13 @@
 //! The synthetic renderer against geometry computed independently from the calibration: where a
 //! rock's pixels fall (bearing, ground contact, stereo parallax), occlusion and determinism.
 
-use qrm::calib::Calibration;
-use qrm::geometry::Point;
-use qrm::synth::{render, Eye, Lump, Pose, Render, World};
+use qrm_core::geometry::Point;
+use qrm_synth::{render, Eye, Lump, Pose, Render, World};
+use qrm_vision::calib::Calibration;
 use std::f64::consts::TAU;
 
 fn calibration() -> Calibration {
-    Calibration::parse(include_str!("../calib/default.toml"), "default.toml").unwrap()
+    qrm_synth::default_calibration()
 }
 
 /// A world of one ball of radius `r` per position, each sunk so that its centre is 5 cm below

@@ -1,0 +1,162 @@
+//! `pipeline eval --run OUT --truth truth.json`: scores a run against the renderer's truth
+//! (docs/RUN.md): eval.json and a printed report.
+
+use super::output::write_atomic;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use qrm_core::edc::Edc;
+use qrm_core::map::Hypergraph;
+use qrm_synth::dataset::Truth;
+use qrm_synth::evaluation::{self, Detectable, Evaluation, RunFiles};
+use qrm_vision::calib::Calibration;
+use qrm_vision::detection::DetectorSettings;
+use qrm_vision::run::{LandmarkRecord, StationRecord};
+use std::path::{Path, PathBuf};
+
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// Output directory of `pipeline run`.
+    #[arg(long)]
+    pub run: PathBuf,
+    /// The dataset's truth.json.
+    #[arg(long)]
+    pub truth: PathBuf,
+    /// The calibration the run used (default: calib.toml beside the truth file).
+    #[arg(long)]
+    pub calib: Option<PathBuf>,
+    /// Where eval.json goes (default: the run directory).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+pub fn run(args: EvalArgs) -> Result<()> {
+    let out = args.out.clone().unwrap_or_else(|| args.run.clone());
+    let calib_path = args
+        .calib
+        .clone()
+        .unwrap_or_else(|| args.truth.with_file_name("calib.toml"));
+    let calib = Calibration::load(&calib_path)?;
+    evaluate_run(&args.run, &args.truth, &calib, &out)
+}
+
+fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    serde_json::from_str(&text)
+        .with_context(|| format!("{} is not a valid file of its kind", path.display()))
+}
+
+/// Scores the run in `run_dir` against `truth_path`, writing `eval.json` into `out`.
+pub fn evaluate_run(
+    run_dir: &Path,
+    truth_path: &Path,
+    calib: &Calibration,
+    out: &Path,
+) -> Result<()> {
+    let truth: Truth = read(truth_path)?;
+    let records: Vec<StationRecord> = read(&run_dir.join("stations.json"))?;
+    let landmarks: Vec<LandmarkRecord> = read(&run_dir.join("landmarks.json"))?;
+    let map_path = run_dir.join("map.json");
+    let map_text = std::fs::read_to_string(&map_path)
+        .with_context(|| format!("cannot read {}", map_path.display()))?;
+    let map = Hypergraph::<Edc>::from_json(&map_text)
+        .with_context(|| format!("{}", map_path.display()))?;
+    if let Err(problem) = evaluation::check_files(&truth, &records, &landmarks) {
+        bail!(
+            "{} does not fit the run in {}: {problem}",
+            truth_path.display(),
+            run_dir.display()
+        );
+    }
+    let settings = DetectorSettings::default();
+    let eval = evaluation::evaluate_run(
+        &RunFiles {
+            records: &records,
+            landmarks: &landmarks,
+            map: &map,
+        },
+        &truth,
+        calib,
+        Detectable {
+            min_width_m: settings.min_width_m,
+            max_range_m: settings.max_range_m,
+        },
+    );
+    write_atomic(
+        &out.join("eval.json"),
+        (serde_json::to_string_pretty(&eval)? + "\n").as_bytes(),
+    )?;
+    print_report(&eval);
+    Ok(())
+}
+
+fn print_report(e: &Evaluation) {
+    let d = &e.detection;
+    println!("evaluation against truth:");
+    println!(
+        "  detection: precision {:.3} ({} of {}), recall {:.3} ({} of {} detectable) over {} images",
+        d.precision, d.true_detections, d.detections, d.recall, d.detectable_found, d.detectable, d.images
+    );
+    for (name, b) in [("all", &e.bearing), ("used", &e.bearing_used)] {
+        println!(
+            "  bearing error ({name:<4}): {} bearings, median {:.3}°, worst {:.3}°; inside its interval {:.1} % (worst error/interval {:.2})",
+            b.count,
+            b.median_error_deg,
+            b.worst_error_deg,
+            100.0 * b.within_interval,
+            b.worst_error_ratio
+        );
+    }
+    let r = &e.range;
+    for (name, c) in [
+        ("ground", &r.ground),
+        ("stereo", &r.stereo),
+        ("size", &r.size),
+        ("fused", &r.fused),
+    ] {
+        println!(
+            "  range cue {name:<6}: {} intervals, {:.1} % hold the truth, median width {:.0} % of range",
+            c.count,
+            100.0 * c.holds_truth,
+            100.0 * c.median_relative_width
+        );
+    }
+    println!(
+        "  range order: {} of {} pairs asserted, {} wrong; {} cue conflicts",
+        r.asserted_pairs, r.pairs, r.wrong_pairs, r.conflicts
+    );
+    println!(
+        "  of all {} asserted pairs, separated by ground alone {}, stereo alone {}, size alone {}, only by the fusion {}",
+        r.asserted_all,
+        r.separated_by_ground, r.separated_by_stereo, r.separated_by_size, r.separated_only_fused
+    );
+    let a = &e.association;
+    println!(
+        "  association: accuracy {:.3} ({} of {} sightings), {} landmarks, {} rocks duplicated, {} landmarks mixed, {} sightings of false detections",
+        a.accuracy, a.correct_sightings, a.sightings, a.landmarks, a.duplicated_rocks, a.mixed_landmarks, a.unmatched_sightings
+    );
+    for (name, m) in [("run", &e.map.run), ("exact", &e.map.exact)] {
+        println!(
+            "  map ({name:<5}): {} landmarks, {} triples, {:.1} % open ({:.1} % among landmarks of one rock each), {:.1} % of incorrect states removed, {:.1} % fully constrained, {} unsound relations",
+            m.landmarks, m.triples, m.open_pct, m.open_pct_defined, m.removed_incorrect_pct, m.fully_constrained_pct, m.unsound_relations
+        );
+        if !m.unsound_landmarks.is_empty() {
+            let worst: Vec<String> = m
+                .unsound_landmarks
+                .iter()
+                .take(5)
+                .map(|(l, n)| format!("{l} ({n})"))
+                .collect();
+            println!(
+                "    landmarks in most unsound relations: {}",
+                worst.join(", ")
+            );
+        }
+    }
+    if let Some(rng) = &e.map.rng {
+        println!(
+            "  RNG: precision {:.2}, recall {:.2}, {} true edges pruned",
+            rng.precision, rng.recall, rng.true_edges_pruned
+        );
+    }
+}

@@ -1,0 +1,102 @@
+//! `pipeline measure`: the relations of one triple from bearings and a range order (000 §IV).
+
+use super::CalculusName;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use qrm_core::calculus::{Calculus, RelationSet};
+use qrm_core::edc::Edc;
+use qrm_core::fdc::Fdc;
+use qrm_core::measurement::{Bearing, Panorama, RangeOrder, MAX_BEARING_UNCERTAINTY};
+
+#[derive(Args, Debug)]
+pub struct MeasureArgs {
+    /// Bearing of landmark A in degrees, counter-clockwise, any zero.
+    #[arg(allow_hyphen_values = true)]
+    a: f64,
+    /// Bearing of landmark B in degrees.
+    #[arg(allow_hyphen_values = true)]
+    b: f64,
+    /// Bearing of landmark C in degrees.
+    #[arg(allow_hyphen_values = true)]
+    c: f64,
+    /// Range order, nearest first: a chain `A<B<C` or comma-separated pairs `A<B,A<C`; pairs
+    /// left out are unknown. Empty: no order known.
+    #[arg(long, default_value = "")]
+    order: String,
+    /// Bearing uncertainty: each true bearing lies within ± this many degrees.
+    #[arg(long, default_value_t = 0.0)]
+    uncertainty: f64,
+    #[arg(long, value_enum, default_value = "edc")]
+    calculus: CalculusName,
+}
+
+/// `A<B<C`, `A<B,A<C` → pairs of indices (0 = A), nearer first.
+pub fn parse_order(text: &str) -> Result<Vec<(usize, usize)>> {
+    let mut pairs = Vec::new();
+    for chain in text.split(',').map(str::trim).filter(|c| !c.is_empty()) {
+        let names: Vec<&str> = chain.split('<').map(str::trim).collect();
+        if names.len() < 2 {
+            bail!("order {chain:?} must look like A<B or A<B<C");
+        }
+        let index = |name: &str| match name {
+            "A" | "a" => Ok(0),
+            "B" | "b" => Ok(1),
+            "C" | "c" => Ok(2),
+            _ => bail!("unknown landmark {name:?} in order {chain:?}: use A, B, C"),
+        };
+        for w in names.windows(2) {
+            pairs.push((index(w[0])?, index(w[1])?));
+        }
+    }
+    Ok(pairs)
+}
+
+pub fn run(args: MeasureArgs) -> Result<()> {
+    let pairs = parse_order(&args.order)?;
+    let order = RangeOrder::from_pairs(3, &pairs).context("range order")?;
+    if !(0.0..MAX_BEARING_UNCERTAINTY.to_degrees()).contains(&args.uncertainty) {
+        bail!(
+            "--uncertainty {} must lie in [0, {}) degrees",
+            args.uncertainty,
+            MAX_BEARING_UNCERTAINTY.to_degrees()
+        );
+    }
+    let bearings = [args.a, args.b, args.c]
+        .iter()
+        .map(|deg| Bearing {
+            angle: deg.to_radians(),
+            uncertainty: args.uncertainty.to_radians(),
+        })
+        .collect();
+    let panorama = Panorama::new(bearings, order)?;
+    match args.calculus {
+        CalculusName::Edc => print::<Edc>(&panorama),
+        CalculusName::Fdc => print::<Fdc>(&panorama),
+    }
+    Ok(())
+}
+
+fn print<C: Calculus>(panorama: &Panorama) {
+    let [ab_c, bc_a, ca_b] = panorama.measure_triple::<C>([0, 1, 2], [C::universe(); 3]);
+    let inverse = |s: RelationSet| C::tables().inverse(s);
+    println!("AB:C = {ab_c}");
+    println!("BC:A = {bc_a}");
+    println!("CA:B = {ca_b}");
+    println!("BA:C = {}", inverse(ab_c));
+    println!("CB:A = {}", inverse(bc_a));
+    println!("AC:B = {}", inverse(ca_b));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orders_parse_as_chains_and_pairs() {
+        assert_eq!(parse_order("A<B<C").unwrap(), vec![(0, 1), (1, 2)]);
+        assert_eq!(parse_order("A<B, c<a").unwrap(), vec![(0, 1), (2, 0)]);
+        assert!(parse_order("").unwrap().is_empty());
+        assert!(parse_order("A<D").is_err());
+        assert!(parse_order("AB").is_err());
+    }
+}

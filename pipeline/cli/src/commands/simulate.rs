@@ -1,0 +1,498 @@
+//! `pipeline simulate`: simulated mapping with ground truth (000 §VIII-B; 003 §1.5.2).
+
+use super::output::write_atomic;
+use super::CalculusName;
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use qrm_core::calculus::Calculus;
+use qrm_core::edc::Edc;
+use qrm_core::fdc::Fdc;
+use qrm_core::geometry::Point;
+use qrm_core::map::Hypergraph;
+use qrm_core::measurement::MAX_BEARING_UNCERTAINTY;
+use qrm_core::neighborhood::{estimate, true_rng};
+use qrm_core::simulation::{
+    observations, run, MonteCarlo, MonteCarloResult, Scenario, Sensor, Series, Statistic,
+};
+use qrm_plot::{write_panels, write_rng, Curve, Panel, RngPicture};
+use rand::SeedableRng;
+use std::fmt::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Largest simulated map: 300 landmarks are 4.5 M triples (about 60 MB) and take minutes.
+const MAX_SIMULATED_LANDMARKS: usize = 300;
+
+#[derive(Subcommand, Debug)]
+pub enum SimulateCommand {
+    /// Monte Carlo study over random maps; `--study fig7` reproduces 000 Fig. 7, `--study
+    /// dissertation` 003 Fig. 1.6b. Writes montecarlo.csv and the panels as PNG and SVG.
+    Montecarlo(MonteCarloArgs),
+    /// One random map: writes the final map (JSON), its RNG (JSON), and per-image metrics (CSV).
+    Single(SingleArgs),
+    /// 003 Fig. 1.5: four landmarks, imaging points chosen one by one where they constrain the
+    /// map most, until it is fully constrained.
+    Basic(BasicArgs),
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum Study {
+    Fig7,
+    Dissertation,
+}
+
+/// Sensor options shared by the studies.
+#[derive(Args, Debug, Clone)]
+pub struct SensorArgs {
+    /// Bearing noise: errors uniform within ± this many degrees (the measurement is told so).
+    #[arg(long, default_value_t = 0.0)]
+    bearing_noise: f64,
+    /// Probability of swapping each adjacent pair of the true range order (range-order errors;
+    /// rejected panoramas are counted as contradictions).
+    #[arg(long, default_value_t = 0.0)]
+    order_swaps: f64,
+}
+
+impl SensorArgs {
+    fn sensor(&self, nearest: Option<usize>) -> Result<Sensor> {
+        if nearest.is_some_and(|n| n < 3) {
+            bail!("--nearest must be at least 3 (a triple)");
+        }
+        if !(0.0..MAX_BEARING_UNCERTAINTY.to_degrees()).contains(&self.bearing_noise) {
+            bail!(
+                "--bearing-noise {} must lie in [0, {}) degrees",
+                self.bearing_noise,
+                MAX_BEARING_UNCERTAINTY.to_degrees()
+            );
+        }
+        if !(0.0..=1.0).contains(&self.order_swaps) {
+            bail!("--order-swaps {} must be a probability", self.order_swaps);
+        }
+        Ok(Sensor {
+            nearest,
+            bearing_noise: self.bearing_noise.to_radians(),
+            bearing_uncertainty: self.bearing_noise.to_radians(),
+            order_swap_probability: self.order_swaps,
+        })
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct MonteCarloArgs {
+    #[arg(long, value_enum, default_value = "fig7")]
+    study: Study,
+    /// Override the number of random maps.
+    #[arg(long)]
+    maps: Option<usize>,
+    /// Override the number of imaging points per map.
+    #[arg(long)]
+    stations: Option<usize>,
+    /// Override the nearest-landmark counts, e.g. `6,9,12,18,24,30`.
+    #[arg(long, value_delimiter = ',')]
+    nearest: Vec<usize>,
+    #[arg(long, value_enum)]
+    calculus: Option<CalculusName>,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    #[command(flatten)]
+    sensor: SensorArgs,
+    /// Output directory.
+    #[arg(long, default_value = "montecarlo")]
+    out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct SingleArgs {
+    #[arg(long, default_value_t = 30)]
+    landmarks: usize,
+    #[arg(long, default_value_t = 50)]
+    stations: usize,
+    /// Use the n nearest landmarks at each imaging point (default: all).
+    #[arg(long)]
+    nearest: Option<usize>,
+    #[arg(long, value_enum, default_value = "edc")]
+    calculus: CalculusName,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    #[command(flatten)]
+    sensor: SensorArgs,
+    /// Output directory.
+    #[arg(long, default_value = "simulation")]
+    out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct BasicArgs {
+    #[arg(long, value_enum, default_value = "edc")]
+    calculus: CalculusName,
+    #[arg(long, default_value_t = 3)]
+    seed: u64,
+}
+
+pub fn run_command(command: SimulateCommand) -> Result<()> {
+    match command {
+        SimulateCommand::Montecarlo(args) => montecarlo(args),
+        SimulateCommand::Single(args) => match args.calculus {
+            CalculusName::Edc => single::<Edc>(&args),
+            CalculusName::Fdc => single::<Fdc>(&args),
+        },
+        SimulateCommand::Basic(args) => match args.calculus {
+            CalculusName::Edc => basic::<Edc>(args.seed),
+            CalculusName::Fdc => basic::<Fdc>(args.seed),
+        },
+    }
+}
+
+fn montecarlo(args: MonteCarloArgs) -> Result<()> {
+    let (mut study, default_calculus) = match args.study {
+        Study::Fig7 => (MonteCarlo::fig7(), CalculusName::Edc),
+        Study::Dissertation => (MonteCarlo::dissertation_random(), CalculusName::Fdc),
+    };
+    if let Some(maps) = args.maps {
+        study.maps = maps;
+    }
+    if let Some(stations) = args.stations {
+        study.stations = stations;
+    }
+    if !args.nearest.is_empty() {
+        study.nearest = args.nearest.iter().map(|&n| Some(n)).collect();
+    }
+    if study.maps == 0 || study.stations == 0 {
+        bail!("--maps and --stations must be positive");
+    }
+    if study.nearest.iter().flatten().any(|&n| n < 3) {
+        bail!("--nearest values must be at least 3 (a triple)");
+    }
+    study.sensor = args.sensor.sensor(None)?;
+    study.seed = args.seed;
+    let bar = progress(study.runs() as u64, "mapping runs");
+    let start = Instant::now();
+    let result = match args.calculus.unwrap_or(default_calculus) {
+        CalculusName::Edc => study.run::<Edc>(&|| bar.inc(1)),
+        CalculusName::Fdc => study.run::<Fdc>(&|| bar.inc(1)),
+    };
+    bar.finish_and_clear();
+    let elapsed = start.elapsed().as_secs_f64();
+    write_atomic(&args.out.join("montecarlo.csv"), result.to_csv().as_bytes())?;
+    let summary = summary(&result, elapsed);
+    write_atomic(&args.out.join("summary.txt"), summary.as_bytes())?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create directory {}", args.out.display()))?;
+    let panels = montecarlo_panels(&result);
+    for name in ["montecarlo.png", "montecarlo.svg"] {
+        write_panels(&args.out.join(name), "image number", &panels)?;
+    }
+    print!("{summary}");
+    println!(
+        "wrote {}/montecarlo.csv, summary.txt, montecarlo.png, montecarlo.svg",
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// 000 Fig. 7 (a)–(d) for a calculus with a lune; 003 Fig. 1.6b otherwise.
+fn montecarlo_panels(result: &MonteCarloResult) -> Vec<Panel> {
+    let curves = |pick: &dyn Fn(&Series) -> &Vec<Statistic>, scale: f64, band: bool| {
+        result
+            .series
+            .iter()
+            .map(|s| Curve {
+                label: s.label(),
+                mean: pick(s).iter().map(|x| x.mean * scale).collect(),
+                std: if band {
+                    pick(s).iter().map(|x| x.std * scale).collect()
+                } else {
+                    Vec::new()
+                },
+            })
+            .collect::<Vec<_>>()
+    };
+    let panel = |title: &str, y: &str, curves: Vec<Curve>| Panel {
+        title: title.to_string(),
+        y_label: y.to_string(),
+        curves,
+    };
+    let time = panel(
+        "(d) time per update",
+        "ms",
+        curves(&|s| &s.seconds, 1e3, false),
+    );
+    if result.calculus == Edc::NAME {
+        vec![
+            panel(
+                "(a) incorrect states removed",
+                "% of incorrect states",
+                curves(&|s| &s.removed_incorrect_pct, 1.0, true),
+            ),
+            panel(
+                "(b) open states not adjacent to the true state",
+                "% of open states",
+                curves(&|s| &s.non_adjacent_open_pct, 1.0, true),
+            ),
+            panel(
+                "(c) total RNG edge cost",
+                "sum of w_ij",
+                curves(&|s| &s.rng_cost, 1.0, true),
+            ),
+            time,
+        ]
+    } else {
+        vec![
+            panel(
+                "(a) open states",
+                "% of all states",
+                curves(&|s| &s.open_pct, 1.0, true),
+            ),
+            panel(
+                "(b) fully constrained triples",
+                "% of triples",
+                curves(&|s| &s.fully_constrained_pct, 1.0, true),
+            ),
+            panel(
+                "(c) incorrect states removed",
+                "% of incorrect states",
+                curves(&|s| &s.removed_incorrect_pct, 1.0, true),
+            ),
+            time,
+        ]
+    }
+}
+
+/// The figures the papers comment on, per series.
+fn summary(result: &MonteCarloResult, seconds: f64) -> String {
+    let s = &result.study;
+    let mut out = format!(
+        "{} Monte Carlo: {} maps × {} landmarks × {} imaging points, {:.1} s wall\n",
+        result.calculus, s.maps, s.landmarks, s.stations, seconds
+    );
+    let _ = writeln!(
+        out,
+        "{:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>8} {:>8}",
+        "series",
+        "removed@1",
+        "removed@10",
+        "removed@end",
+        "nonadj@end",
+        "full@end",
+        "open@end",
+        "rngcost@end",
+        "rng prec",
+        "rng rec",
+        "ms/upd",
+        "unsound"
+    );
+    for series in &result.series {
+        let last = series.seconds.len() - 1;
+        let at10 = 9.min(last);
+        let mean_ms =
+            1e3 * series.seconds.iter().map(|x| x.mean).sum::<f64>() / series.seconds.len() as f64;
+        // Adjacency and the RNG are EDC notions (lune, region adjacency).
+        let edc_only = |v: f64, digits: usize| {
+            if result.calculus == Edc::NAME {
+                format!("{v:.digits$}")
+            } else {
+                "-".to_string()
+            }
+        };
+        let _ = writeln!(
+            out,
+            "{:>6} {:>10.1} {:>10.1} {:>11.1} {:>10} {:>10.1} {:>10.1} {:>11} {:>9} {:>9} {:>8.2} {:>8}",
+            series.label(),
+            series.removed_incorrect_pct[0].mean,
+            series.removed_incorrect_pct[at10].mean,
+            series.removed_incorrect_pct[last].mean,
+            edc_only(series.non_adjacent_open_pct[last].mean, 1),
+            series.fully_constrained_pct[last].mean,
+            series.open_pct[last].mean,
+            edc_only(series.rng_cost[last].mean, 3),
+            edc_only(series.rng_precision.mean, 3),
+            edc_only(series.rng_recall.mean, 3),
+            mean_ms,
+            series.unsound_relations
+        );
+        if series.contradictions > 0 {
+            let _ = writeln!(
+                out,
+                "       {} panoramas rejected as contradictions",
+                series.contradictions
+            );
+        }
+    }
+    out
+}
+
+fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
+    if args.landmarks < 3 || args.stations == 0 {
+        bail!("need at least 3 landmarks and 1 imaging point");
+    }
+    if args.landmarks > MAX_SIMULATED_LANDMARKS {
+        bail!(
+            "--landmarks {} is more than this simulation handles ({MAX_SIMULATED_LANDMARKS}): the map grows as n³",
+            args.landmarks
+        );
+    }
+    let scenario = Scenario::random(args.seed, args.landmarks, args.stations, 100.0);
+    let sensor = args.sensor.sensor(args.nearest)?;
+    let start = Instant::now();
+    let (steps, map) = run::<C>(&scenario, &sensor, args.seed);
+    let elapsed = start.elapsed().as_secs_f64();
+    let mut csv = String::from(
+        "image,visible,removed_incorrect_pct,non_adjacent_open_pct,fully_constrained_pct,open_pct,rng_cost,rng_precision,rng_recall,seconds,contradiction,unsound_relations\n",
+    );
+    for (i, s) in steps.iter().enumerate() {
+        let _ = writeln!(
+            csv,
+            "{},{},{:.4},{:.4},{:.4},{:.4},{:.6},{:.4},{:.4},{:.6},{},{}",
+            i + 1,
+            s.visible,
+            s.metrics.removed_incorrect_pct,
+            s.metrics.non_adjacent_open_pct,
+            s.metrics.fully_constrained_pct,
+            s.metrics.open_pct,
+            s.rng_cost.unwrap_or(0.0),
+            s.rng.map_or(f64::NAN, |c| c.precision()),
+            s.rng.map_or(f64::NAN, |c| c.recall()),
+            s.seconds,
+            s.contradiction,
+            s.metrics.unsound_relations
+        );
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create directory {}", args.out.display()))?;
+    // The picture is the only output that can fail on the data, so it goes first.
+    if let Some(rng) = estimate(&map) {
+        let landmarks: Vec<(f64, f64)> = map
+            .landmarks()
+            .iter()
+            .map(|&id| {
+                let p = scenario.landmarks[id as usize];
+                (p.x, p.y)
+            })
+            .collect();
+        let index = |id: u32| {
+            map.landmarks()
+                .iter()
+                .position(|&x| x == id)
+                .expect("map landmark")
+        };
+        let edges: Vec<(usize, usize, f64)> = rng
+            .edges
+            .iter()
+            .map(|e| (index(e.a), index(e.b), e.cost))
+            .collect();
+        let mapped: Vec<Point> = landmarks.iter().map(|&(x, y)| Point::new(x, y)).collect();
+        let true_edges = true_rng(&mapped);
+        let stations: Vec<(f64, f64)> = scenario.stations.iter().map(|p| (p.x, p.y)).collect();
+        write_rng(
+            &args.out.join("rng.png"),
+            &RngPicture {
+                title: format!("RNG estimate after {} images", steps.len()),
+                landmarks: &landmarks,
+                edges: &edges,
+                true_edges: &true_edges,
+                stations: &stations,
+            },
+        )?;
+        write_atomic(
+            &args.out.join("rng.json"),
+            super::rng_json(&map, &rng).as_bytes(),
+        )?;
+        println!(
+            "RNG: {} edges kept ({} certain), {} pruned; true RNG has {} edges",
+            rng.edges.len(),
+            rng.certain().count(),
+            rng.pruned,
+            true_edges.len()
+        );
+    }
+    write_atomic(&args.out.join("steps.csv"), csv.as_bytes())?;
+    write_atomic(&args.out.join("map.json"), map.to_json().as_bytes())?;
+    let last = steps.last().expect("at least one station");
+    println!(
+        "{} map of {} landmarks after {} images in {:.2} s: {:.1}% incorrect states removed, {:.1}% triples fully constrained, {} unsound relations, {} contradictions",
+        C::NAME,
+        map.len(),
+        steps.len(),
+        elapsed,
+        last.metrics.removed_incorrect_pct,
+        last.metrics.fully_constrained_pct,
+        last.metrics.unsound_relations,
+        steps.iter().filter(|s| s.contradiction).count()
+    );
+    println!(
+        "wrote {}/steps.csv, map.json{}",
+        args.out.display(),
+        if C::lune().is_some() {
+            ", rng.json, rng.png"
+        } else {
+            ""
+        }
+    );
+    Ok(())
+}
+
+/// Greedy choice of imaging points for a small map (003 Fig. 1.5): each next point is the one
+/// of a grid that leaves the fewest open states.
+fn basic<C: Calculus>(seed: u64) -> Result<()> {
+    let scenario = Scenario::random(seed, 4, 0, 100.0);
+    let sensor = Sensor::exact(None);
+    let candidates: Vec<Point> = (0..40)
+        .flat_map(|i| {
+            (0..40).map(move |j| Point::new(2.5 * i as f64 + 1.25, 2.5 * j as f64 + 1.25))
+        })
+        .collect();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut map = Hypergraph::<C>::new();
+    println!(
+        "{} map of 4 landmarks {:?}",
+        C::NAME,
+        scenario
+            .landmarks
+            .iter()
+            .map(|p| (p.x.round(), p.y.round()))
+            .collect::<Vec<_>>()
+    );
+    for image in 1..=7 {
+        let best = candidates
+            .iter()
+            .map(|&station| {
+                let (ids, panorama) = sensor.observe(&scenario.landmarks, station, &mut rng);
+                let mut trial = map.clone();
+                let _ = trial.fuse(&observations(&trial, &ids, &panorama));
+                (trial.open_states(), station, trial)
+            })
+            .min_by_key(|(open, _, _)| *open)
+            .expect("candidates");
+        map = best.2;
+        let full = map.fully_constrained_triples();
+        println!(
+            "image {image} at ({:.1}, {:.1}): {} open states in {} triples, {} fully constrained",
+            best.1.x,
+            best.1.y,
+            best.0,
+            map.triple_count(),
+            full
+        );
+        if full == map.triple_count() {
+            println!(
+                "fully constrained after {image} images (003 Fig. 1.6a: 7 hand-picked images)"
+            );
+            break;
+        }
+    }
+    Ok(())
+}
+
+fn progress(len: u64, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} {msg} [{bar:40}] {pos}/{len} ({elapsed}, eta {eta})",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
+}

@@ -1,0 +1,355 @@
+//! The recorders on synthetic stations: every channel, one message per station, messages that
+//! match their schemas, and nothing at the target unless `finish` succeeded.
+//!
+//! With `QRM_RECORDING_SAMPLES=DIR` the finished recordings are also copied to `DIR`
+//! (`sample.mcap`, `sample.rrd`), for CI to check them with the independent Python tools.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use super::*;
+use qrm_vision::run::{
+    Association, DetectionRecord, FusionRecord, MetricsRecord, RangeRecord, StageSeconds,
+};
+
+const STATIONS: usize = 16;
+
+const TOPICS: [&str; 7] = [
+    "/detections",
+    "/bearings",
+    "/range_order",
+    "/association",
+    "/measurements",
+    "/map_metrics",
+    "/rng",
+];
+
+fn station(index: usize) -> StationRecord {
+    let count = 2 + index % 4;
+    let detections = (0..count)
+        .map(|k| {
+            let column = (k * 1000 + index * 37) as u32;
+            DetectionRecord {
+                // The last detection of odd stations wraps around the seam.
+                bbox: [
+                    column,
+                    300,
+                    column + if k == 3 { 4200 - column } else { 60 },
+                    420,
+                ],
+                centroid: [f64::from(column) + 30.0, 360.0],
+                contact_row: 420.0,
+                pixels: 5000 + k as u32,
+                stereo_column: (k % 2 == 0).then_some(f64::from(column) + 22.5),
+                bearing: k as f64 * 1.5 - 3.0,
+                bearing_uncertainty: 0.01,
+                range: RangeRecord {
+                    ground: Some([2.0 + k as f64, 4.0 + k as f64]),
+                    stereo: (k % 2 == 0).then_some([2.5, 3.5]),
+                    size: (k == 1).then_some([10.0, f64::INFINITY]),
+                    fused: [2.5, if k == 1 { f64::INFINITY } else { 3.5 }],
+                    conflict: k == 1,
+                },
+                association: match k {
+                    0 => Association::Matched { landmark: 7 },
+                    1 => Association::New {
+                        landmark: 12 + index as u32,
+                    },
+                    2 => Association::HeldBack {
+                        candidates: vec![3, 5],
+                    },
+                    _ => Association::Unused,
+                },
+            }
+        })
+        .collect();
+    StationRecord {
+        index,
+        station: format!("station_{index:03}"),
+        files: vec![
+            format!("station_{index:03}_left.png"),
+            format!("station_{index:03}_right.png"),
+        ],
+        detections,
+        order: vec![(0, 1), (0, 2)],
+        fusion: FusionRecord {
+            landmarks: count,
+            triples: count * (count - 1) * (count - 2) / 6,
+            relations_tightened: index,
+            resolved_held_back: index % 2,
+            contradiction: (index == 5).then(|| "triple (1, 2, 3) emptied".to_string()),
+        },
+        metrics: MetricsRecord {
+            landmarks: 3 + index,
+            triples: 10 * index,
+            open_fraction: 1.0 / (1.0 + index as f64),
+            fully_constrained_fraction: index as f64 / STATIONS as f64,
+            rng_certain: index,
+            rng_uncertain: 2,
+            rng_cost: 2.5,
+        },
+        seconds: StageSeconds {
+            decode: 0.1,
+            detect: 0.2,
+            range: 0.01,
+            associate: 0.02,
+            map: 0.5,
+        },
+        warnings: if index == 5 {
+            vec!["map rejected the panorama".to_string()]
+        } else {
+            Vec::new()
+        },
+    }
+}
+
+fn drawing(index: usize) -> RngDrawing {
+    let landmarks: Vec<_> = (0..3 + index as u32)
+        .map(|id| (id, [f64::from(id).cos() * 10.0, f64::from(id).sin() * 10.0]))
+        .collect();
+    let edges = landmarks
+        .windows(2)
+        .map(|w| (w[0].0, w[1].0, f64::from(w[0].0 % 3) / 2.0))
+        .collect();
+    RngDrawing { landmarks, edges }
+}
+
+/// A 4096×1024 panorama like the rover's: smooth shading plus sensor-like noise, so the `.rrd`
+/// size is near a real run's.
+#[cfg(feature = "rerun")]
+fn panorama() -> image::RgbImage {
+    let mut state = 0x9e37_79b9_u32;
+    image::RgbImage::from_fn(4096, 1024, |x, y| {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        let noise = (state % 16) as u8;
+        image::Rgb([
+            (x / 16) as u8 / 2 + noise,
+            (y / 4) as u8 / 2 + noise,
+            100 + noise,
+        ])
+    })
+}
+
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("qrm-recording-{name}-"))
+        .tempdir()
+        .unwrap()
+}
+
+fn names_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    names
+}
+
+fn record(mut recorder: Box<dyn Recorder>, stations: usize, panorama: &image::RgbImage) {
+    for index in 0..stations {
+        recorder.station(&station(index), panorama).unwrap();
+        recorder.rng(index, &drawing(index)).unwrap();
+    }
+    recorder.finish().unwrap();
+}
+
+/// Copies a finished recording to `$QRM_RECORDING_SAMPLES/sample.<extension>`.
+fn keep_sample(path: &Path) {
+    if let Some(dir) = std::env::var_os("QRM_RECORDING_SAMPLES") {
+        let dir = PathBuf::from(dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let extension = path.extension().unwrap().to_str().unwrap();
+        std::fs::copy(path, dir.join(format!("sample.{extension}"))).unwrap();
+    }
+}
+
+/// Checks `value` against the parts of JSON Schema that `schemas/*.json` use.
+fn check(value: &Value, schema: &Value, root: &Value, at: &str) {
+    if let Some(reference) = schema["$ref"].as_str() {
+        let name = reference.strip_prefix("#/$defs/").unwrap();
+        return check(value, &root["$defs"][name], root, at);
+    }
+    let kind = match value {
+        Value::Null => "null",
+        Value::Bool(_) => "boolean",
+        Value::Number(n) if n.is_u64() || n.is_i64() => "integer",
+        Value::Number(_) => "number",
+        Value::String(_) => "string",
+        Value::Array(_) => "array",
+        Value::Object(_) => "object",
+    };
+    let allows = |t: &Value| t == kind || (t == "number" && kind == "integer");
+    match &schema["type"] {
+        Value::Null => {}
+        Value::Array(types) => assert!(types.iter().any(allows), "{at}: {kind} not in {types:?}"),
+        t => assert!(allows(t), "{at}: {kind} is not {t}"),
+    }
+    if let Some(options) = schema["enum"].as_array() {
+        assert!(options.contains(value), "{at}: {value} not in {options:?}");
+    }
+    match value {
+        Value::Object(fields) => {
+            for key in schema["required"].as_array().into_iter().flatten() {
+                assert!(fields.contains_key(key.as_str().unwrap()), "{at}: no {key}");
+            }
+            for (key, field) in fields {
+                let field_schema = &schema["properties"][key];
+                assert!(!field_schema.is_null(), "{at}: {key} not in the schema");
+                check(field, field_schema, root, &format!("{at}.{key}"));
+            }
+        }
+        Value::Array(items) => {
+            if let Some(n) = schema["minItems"].as_u64() {
+                assert!(items.len() as u64 >= n, "{at}: too few items");
+            }
+            if let Some(n) = schema["maxItems"].as_u64() {
+                assert!(items.len() as u64 <= n, "{at}: too many items");
+            }
+            for (i, item) in items.iter().enumerate() {
+                check(item, &schema["items"], root, &format!("{at}[{i}]"));
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Records `STATIONS` stations into `dir/file` with recorders from `create`, after checking
+/// that a recording dropped unfinished leaves nothing behind; returns the finished file.
+fn record_whole(
+    dir: &Path,
+    file: &str,
+    create: impl Fn(&Path) -> Box<dyn Recorder>,
+    panorama: &image::RgbImage,
+) -> PathBuf {
+    let path = dir.join(file);
+    let mut recorder = create(&path);
+    recorder.station(&station(0), panorama).unwrap();
+    assert!(!path.exists(), "the target appears only on finish");
+    drop(recorder);
+    assert!(
+        names_in(dir).is_empty(),
+        "an unfinished recording leaves nothing"
+    );
+    record(create(&path), STATIONS, panorama);
+    assert_eq!(names_in(dir), [file]);
+    keep_sample(&path);
+    path
+}
+
+#[test]
+fn mcap_has_every_channel_once_per_station_matching_its_schema() {
+    let dir = scratch("mcap");
+    let path = record_whole(
+        dir.path(),
+        "run.mcap",
+        |path| Box::new(McapRecorder::create(path).unwrap()),
+        &image::RgbImage::new(8, 2),
+    );
+
+    let bytes = std::fs::read(&path).unwrap();
+    let summary = ::mcap::Summary::read(&bytes).unwrap().unwrap();
+    let topics: BTreeSet<_> = summary
+        .channels
+        .values()
+        .map(|c| c.topic.as_str())
+        .collect();
+    assert_eq!(topics, TOPICS.into_iter().collect());
+    let stats = summary.stats.unwrap();
+    assert_eq!(stats.message_count, (STATIONS * TOPICS.len()) as u64);
+    assert_eq!(
+        stats.message_end_time,
+        (STATIONS as u64 - 1) * 1_000_000_000
+    );
+
+    let mut indices: BTreeMap<String, Vec<u64>> = BTreeMap::new();
+    for message in ::mcap::MessageStream::new(&bytes).unwrap() {
+        let message = message.unwrap();
+        let channel = &message.channel;
+        assert_eq!(channel.message_encoding, "json");
+        let schema = channel.schema.as_ref().unwrap();
+        assert_eq!(schema.encoding, "jsonschema");
+        let schema: Value = serde_json::from_slice(&schema.data).unwrap();
+        let value: Value = serde_json::from_slice(&message.data).unwrap();
+        check(&value, &schema, &schema, &channel.topic);
+        let index = value["index"].as_u64().unwrap();
+        assert_eq!(message.log_time, index * 1_000_000_000);
+        assert_eq!(message.publish_time, message.log_time);
+        let expected = station(index as usize);
+        match channel.topic.as_str() {
+            "/detections" => {
+                assert_eq!(value["station"], expected.station);
+                let detections = value["detections"].as_array().unwrap();
+                assert_eq!(detections.len(), expected.detections.len());
+                assert_eq!(detections[1]["stereo_column"], Value::Null);
+            }
+            "/range_order" => {
+                // JSON has no infinity: an unbounded interval ends in null.
+                assert_eq!(value["ranges"][1]["fused"][1], Value::Null);
+                assert_eq!(value["nearer"], serde_json::json!([[0, 1], [0, 2]]));
+            }
+            "/association" => {
+                let decisions = &value["associations"];
+                assert_eq!(decisions[0]["decision"], "matched");
+                assert_eq!(decisions[0]["landmark"], 7);
+                if expected.detections.len() > 2 {
+                    assert_eq!(decisions[2]["candidates"], serde_json::json!([3, 5]));
+                }
+            }
+            "/measurements" => {
+                assert_eq!(
+                    value["contradiction"].as_str(),
+                    expected.fusion.contradiction.as_deref()
+                );
+            }
+            "/map_metrics" => assert_eq!(value["landmarks"], expected.metrics.landmarks),
+            "/rng" => {
+                assert_eq!(
+                    value["landmarks"].as_array().unwrap().len(),
+                    3 + index as usize
+                )
+            }
+            _ => {}
+        }
+        indices
+            .entry(channel.topic.clone())
+            .or_default()
+            .push(index);
+    }
+    let every_station: Vec<u64> = (0..STATIONS as u64).collect();
+    assert_eq!(indices.len(), TOPICS.len());
+    for (topic, seen) in indices {
+        assert_eq!(seen, every_station, "{topic}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn recording_errors_name_the_target() {
+    let path = Path::new("/nonexistent-qrm-dir/run.mcap");
+    let error = McapRecorder::create(path).err().unwrap();
+    assert_eq!(error.path, path);
+    assert!(error
+        .to_string()
+        .starts_with("recording /nonexistent-qrm-dir/run.mcap: "));
+}
+
+#[cfg(feature = "rerun")]
+#[test]
+fn rrd_is_written_whole_on_finish_only() {
+    let dir = scratch("rrd");
+    let path = record_whole(
+        dir.path(),
+        "run.rrd",
+        |path| Box::new(RerunRecorder::create(path).unwrap()),
+        &panorama(),
+    );
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(&bytes[..4], b"RRF2", "an rrd stream header");
+    // 16 halved panoramas of 2048×512 RGB are 50 MB raw; rerun's compression keeps them smaller.
+    assert!(bytes.len() < 60_000_000, "{} bytes", bytes.len());
+}

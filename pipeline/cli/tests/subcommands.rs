@@ -1,0 +1,215 @@
+//! Calculus tools, `measure`, `simulate` and `synth`: answers on good input, exit code 2 and a
+//! message naming the problem on bad input.
+
+use super::pipeline;
+use std::process::Output;
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).trim().to_string()
+}
+
+#[test]
+fn answers() {
+    let o = pipeline(&["classify", "0,0", "0,1", "-2,3"]);
+    assert!(o.status.success());
+    assert_eq!(stdout(&o), "1");
+    assert_eq!(
+        stdout(&pipeline(&[
+            "classify",
+            "--calculus",
+            "fdc",
+            "0,0",
+            "0,1",
+            "0,2"
+        ])),
+        "2"
+    );
+    assert_eq!(
+        stdout(&pipeline(&["classify", "0,0", "0,1", "0,3"])),
+        "boundary"
+    );
+    assert_eq!(
+        stdout(&pipeline(&["compose", "1,5,11", "5"])),
+        "{1,5,11,12,17,18,19,20}"
+    );
+    assert_eq!(stdout(&pipeline(&["unary", "left", "{6,7}"])), "{1,5,11}");
+    let demo = pipeline(&["demo"]);
+    assert!(demo.status.success());
+    assert!(stdout(&demo).contains("{1,5,11,12,17,18,19,20}"));
+    assert!(stdout(&pipeline(&["tables"])).contains("0 undecided"));
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    for (args, needle) in [
+        (
+            vec!["classify", "0,0", "0,1", "x,3"],
+            "bad x in point \"x,3\"",
+        ),
+        (vec!["classify", "0,0", "0,1", "1"], "must be written x,y"),
+        (vec!["classify", "1,1", "1,1", "0,0"], "A and B coincide"),
+        (
+            vec!["classify", "0,0", "0,1", "1e200,1e200"],
+            "coordinates too large",
+        ),
+        (
+            vec!["classify", "0,0", "0,1", "nan,1"],
+            "finite coordinates",
+        ),
+        (vec!["compose", "1,21", "5"], "outside 1..=20"),
+        (
+            vec!["compose", "--calculus", "fdc", "16", "5"],
+            "outside 1..=15",
+        ),
+        (vec!["unary", "left", "{1,"], "missing '}'"),
+    ] {
+        let o = pipeline(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn measures_a_triple() {
+    let o = pipeline(&["measure", "0", "40", "100", "--order", "A<B<C"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = stdout(&o);
+    assert!(text.starts_with("AB:C = {1,2,5}"), "{text}");
+    assert_eq!(text.lines().count(), 6);
+    let wide = stdout(&pipeline(&[
+        "measure",
+        "0",
+        "40",
+        "100",
+        "--order",
+        "A<B<C",
+        "--uncertainty",
+        "1",
+    ]));
+    // ±1° admits arrangements the exact bearings do not: AB:C gains regions.
+    let regions = |t: &str| t.lines().next().unwrap().matches(',').count() + 1;
+    assert!(regions(&wide) > regions(&text), "{wide}");
+    for bad in [
+        vec!["measure", "0", "40", "100", "--order", "A<D"],
+        vec!["measure", "0", "40", "100", "--order", "A<B,B<A"],
+        vec!["measure", "0", "40", "100", "--uncertainty", "60"],
+        vec!["measure", "1e20", "0", "90", "--uncertainty", "1"],
+        vec!["measure", "0", "40", "x"],
+    ] {
+        let o = pipeline(&bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+        assert!(!o.stderr.is_empty(), "{bad:?}");
+    }
+}
+
+#[test]
+fn simulates_and_writes_outputs() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let o = pipeline(&[
+        "simulate",
+        "single",
+        "--landmarks",
+        "8",
+        "--stations",
+        "6",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for file in ["steps.csv", "map.json", "rng.json"] {
+        assert!(dir.join(file).is_file(), "{file}");
+    }
+    let map = std::fs::read_to_string(dir.join("map.json")).unwrap();
+    assert!(qrm_core::map::Hypergraph::<qrm_core::edc::Edc>::from_json(&map).is_ok());
+    let o = pipeline(&[
+        "simulate",
+        "montecarlo",
+        "--maps",
+        "2",
+        "--stations",
+        "4",
+        "--nearest",
+        "5,8",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(dir.join("montecarlo.csv").is_file());
+    for bad in [
+        vec!["simulate", "montecarlo", "--nearest", "2"],
+        vec!["simulate", "single", "--nearest", "2"],
+        vec!["simulate", "single", "--landmarks", "100000"],
+        vec!["map", "info", "/nonexistent/map.json"],
+    ] {
+        let o = pipeline(&bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).starts_with("error: "),
+            "{bad:?}"
+        );
+    }
+}
+
+#[test]
+fn synthesises_a_dataset_and_rejects_bad_calibrations() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let o = pipeline(&[
+        "synth",
+        "--preset",
+        "random",
+        "--stations",
+        "2",
+        "--mono",
+        "--scale",
+        "0.1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for file in [
+        "calib.toml",
+        "truth.json",
+        "station_000.png",
+        "station_001.png",
+    ] {
+        assert!(dir.join(file).is_file(), "{file}");
+    }
+    let bad = dir.join("bad.toml");
+    let text = std::fs::read_to_string(dir.join("calib.toml")).unwrap();
+    std::fs::write(&bad, text.replace("height_m", "height")).unwrap();
+    for args in [
+        vec![
+            "synth",
+            "--calib",
+            bad.to_str().unwrap(),
+            "--out",
+            "/tmp/never",
+        ],
+        vec![
+            "synth",
+            "--calib",
+            "/nonexistent/calib.toml",
+            "--out",
+            "/tmp/never",
+        ],
+        vec!["synth", "--scale", "0", "--out", "/tmp/never"],
+        vec!["synth", "--stations", "0", "--out", "/tmp/never"],
+    ] {
+        let o = pipeline(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.starts_with("error: "), "{args:?}: {err}");
+    }
+    let o = pipeline(&[
+        "synth",
+        "--calib",
+        bad.to_str().unwrap(),
+        "--out",
+        "/tmp/never",
+    ]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("height_m"));
+    assert!(!std::path::Path::new("/tmp/never").exists());
+}

@@ -1,0 +1,26 @@
+//! Figures of the paper's evaluation (000 §VIII): Monte-Carlo statistics per image as in
+//! Fig. 7 ([`write_panels`]) and RNG snapshots over the landmark field as in Fig. 11
+//! ([`write_rng`]). Plain data in, PNG or SVG files out (format by extension, written
+//! atomically), so that experiments and tools can plot without knowing the map types.
+//!
+//! Text is rendered with an embedded DejaVu Sans (`pipeline/plot/assets/fonts/`) so that no
+//! fontconfig/freetype is needed on the machine that draws.
+
+mod cost_colour;
+mod error;
+mod font;
+mod layout;
+mod legend;
+mod output;
+mod palette;
+mod panels;
+mod rng;
+mod ticks;
+
+pub use error::PlotError;
+pub use layout::spring_layout;
+pub use panels::{write_panels, Curve, Panel};
+pub use rng::{write_rng, RngPicture};
+
+#[cfg(test)]
+mod test_support;

@@ -1,0 +1,131 @@
+//! Rendering a preset into a dataset directory (`datasets/README.md`): the calibration, the
+//! panoramas and `truth.json`, each file written atomically.
+
+use super::layout::{Counts, Layout, Preset};
+use super::truth::{visible_rocks, ImageTruth, RockTruth, StationTruth, Truth, FORMAT, VERSION};
+use crate::{render, Eye, Render, World};
+use qrm_vision::calib::Calibration;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum DatasetError {
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot encode {path}: {source}")]
+    Encode {
+        path: PathBuf,
+        source: image::ImageError,
+    },
+}
+
+/// What to render.
+#[derive(Clone, Copy, Debug)]
+pub struct Request {
+    pub preset: Preset,
+    pub seed: u64,
+    pub counts: Counts,
+    /// A left and a right panorama per station, or one mono panorama.
+    pub stereo: bool,
+}
+
+/// Renders `request` with `calib` into `dir`; `tick` is called after each station.
+pub fn write_dataset(
+    dir: &Path,
+    calib: &Calibration,
+    request: Request,
+    tick: &(dyn Fn() + Sync),
+) -> Result<Truth, DatasetError> {
+    std::fs::create_dir_all(dir).map_err(|source| DatasetError::Write {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let Layout { rocks, stations } = request.preset.layout(request.seed, request.counts);
+    let world = World::generate(request.seed, &rocks);
+    let eyes: &[(Eye, &str)] = if request.stereo {
+        &[(Eye::Left, "left"), (Eye::Right, "right")]
+    } else {
+        &[(Eye::Mono, "mono")]
+    };
+    let names: Vec<String> = (0..stations.len())
+        .map(|i| format!("station_{i:03}"))
+        .collect();
+    let per_station: Vec<Vec<ImageTruth>> = stations
+        .par_iter()
+        .enumerate()
+        .map(|(i, &pose)| {
+            let images = eyes
+                .iter()
+                .map(|&(eye, label)| {
+                    let image = render(&world, calib, pose, eye);
+                    let file = if request.stereo {
+                        format!("{}_{label}.png", names[i])
+                    } else {
+                        format!("{}.png", names[i])
+                    };
+                    write_png(&dir.join(&file), &image)?;
+                    Ok(ImageTruth {
+                        file,
+                        station: i,
+                        eye: label.to_string(),
+                        rocks: visible_rocks(&world, calib, pose, eye, &image),
+                    })
+                })
+                .collect::<Result<Vec<_>, DatasetError>>();
+            tick();
+            images
+        })
+        .collect::<Result<_, _>>()?;
+    let truth = Truth {
+        format: FORMAT.to_string(),
+        version: VERSION,
+        preset: request.preset.name().to_string(),
+        seed: request.seed,
+        rocks: (0..world.rocks.len() as u32)
+            .map(|id| RockTruth::of(&world, id))
+            .collect(),
+        stations: stations
+            .iter()
+            .zip(&names)
+            .map(|(pose, name)| StationTruth {
+                name: name.clone(),
+                position: [pose.position.x, pose.position.y],
+                heading: pose.heading,
+            })
+            .collect(),
+        images: per_station.into_iter().flatten().collect(),
+    };
+    let json = serde_json::to_string_pretty(&truth).expect("plain data serialises") + "\n";
+    write_file(&dir.join("truth.json"), json.as_bytes())?;
+    write_file(&dir.join("calib.toml"), calib.to_toml().as_bytes())?;
+    Ok(truth)
+}
+
+fn write_file(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
+    qrm_atomic_file::write_bytes(path, bytes).map_err(|source| DatasetError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn write_png(path: &Path, image: &Render) -> Result<(), DatasetError> {
+    qrm_atomic_file::write_via_temporary(
+        path,
+        |temporary| {
+            image
+                .save_png(temporary)
+                .map_err(|source| DatasetError::Encode {
+                    path: path.to_path_buf(),
+                    source,
+                })
+        },
+        |source| DatasetError::Write {
+            path: path.to_path_buf(),
+            source,
+        },
+    )
+}

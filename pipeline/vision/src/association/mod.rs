@@ -1,0 +1,545 @@
+//! Data association (000 §VI-C): which map landmark, if any, each detection of a station is.
+//!
+//! Appearance proposes, the qualitative map decides:
+//! 1. the [`Gallery`] proposes, for each detection, the landmarks whose descriptor and
+//!    physical width are close enough;
+//! 2. **anchors** are the unambiguous correspondences of the rigid motion that best lines up
+//!    the station's look-alike detections with a recent station's landmarks ([`register`]);
+//!    the motion also rules out the frame's landmarks that lie away from a detection. An
+//!    anchor must be paired so by most registered frames that hold its landmark, and anchors
+//!    are checked against each other: a triple of anchors whose measured states do not
+//!    overlap the map's is inconsistent, and the anchor in most such triples is dropped until
+//!    none is left;
+//! 3. every other proposal is tested as 000 §VI-C describes: the detection's triples with
+//!    pairs of anchors are measured and compared with the candidate landmark's relations in
+//!    the map; a candidate with an empty overlap in any relation is rejected;
+//! 4. no candidate left → a new landmark; otherwise the observation is **held back** and
+//!    tried again when the map is tighter, where it becomes a new landmark once every
+//!    candidate has been rejected. Nothing is fused on a guess.
+//!
+//! Why a lone surviving candidate is not matched at once: a rejection is sound evidence (the
+//! map and the measurement exclude each other), a pass is not, since a loose map lets most
+//! look-alikes pass. On sixteen-station half-resolution marsyard and random surveys (`pipeline
+//! synth --scale 0.5 --stations 16`, seeds 1–6) lone survivors matched on a pass were wrong
+//! in 19 of 54 cases and retried held-back observations in 33 of 58 (and still wrong when
+//! matched by elimination of the other candidates), against 30 of about 2300 for registration
+//! anchors; the wrong ones made 8 of those 12 maps unsound.
+
+mod gallery;
+mod registration;
+
+pub use gallery::{distance, AppearanceScales, Gallery, Profile};
+pub use registration::{register, Frame, Placed, Registration};
+
+use crate::detection::Appearance;
+use crate::ranging::RangeInterval;
+use qrm_core::calculus::Calculus;
+use qrm_core::map::{Hypergraph, LandmarkId};
+use qrm_core::measurement::Panorama;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Closest look-alike landmarks per detection that seed registration hypotheses.
+const REGISTRATION_SEEDS: usize = 6;
+
+/// A station's only registration is dropped when this many other frames could have confirmed
+/// it and did not. In the three such cases seen on half-resolution surveys (two stations of
+/// marsyard seed 3, one of random seed 5 under an earlier detector), 7–8 look-alike pairs fit
+/// one frame by chance while the other five failed to register, and every pair was wrong.
+const SILENT_FRAMES: usize = 3;
+
+/// Slack of the placement test against a registered frame, metres: generous, since ruling
+/// out the true landmark would make a duplicate.
+const PLACEMENT_SLACK_M: f64 = 1.0;
+
+/// Thresholds of association.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AssociationSettings {
+    pub scales: AppearanceScales,
+    /// Largest descriptor distance of a candidate.
+    pub gate: f64,
+    /// Triples, with relations the map constrains, a candidate not seen lately must have been
+    /// tested on to stay a candidate.
+    pub informative_triples: usize,
+    /// Most anchor pairs tested per candidate (the most constrained first).
+    pub tested_pairs: usize,
+}
+
+impl Default for AssociationSettings {
+    fn default() -> AssociationSettings {
+        AssociationSettings {
+            scales: AppearanceScales::default(),
+            gate: 5.0,
+            informative_triples: 6,
+            tested_pairs: 20,
+        }
+    }
+}
+
+/// What one detection needs for association.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Evidence {
+    pub appearance: Appearance,
+    /// Physical width bounds from this station's range evidence.
+    pub width: Option<RangeInterval>,
+}
+
+/// The association decision for one detection.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Decision {
+    Matched(LandmarkId),
+    New,
+    HeldBack(Vec<LandmarkId>),
+}
+
+/// Associates the detections of one station (`panorama` holds their bearings and range order,
+/// `evidence` their looks and `placed` their rough positions around the station, all indexed
+/// alike; `frames` are recent stations' landmarks placed the same way).
+pub fn associate<C: Calculus>(
+    map: &Hypergraph<C>,
+    gallery: &Gallery,
+    panorama: &Panorama,
+    evidence: &[Evidence],
+    placed: &[Option<Placed>],
+    frames: &[Frame],
+    settings: &AssociationSettings,
+) -> Vec<Decision> {
+    let n = evidence.len();
+    if gallery.is_empty() {
+        return vec![Decision::New; n];
+    }
+    let candidates: Vec<Vec<(LandmarkId, f64)>> = evidence
+        .iter()
+        .map(|e| proposals(e, gallery, settings))
+        .collect();
+    let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
+    // Registration hypotheses grow with the square of the seeds: each detection seeds only
+    // with its closest few look-alikes (the lists are sorted by descriptor distance).
+    let seed = |i: usize, l: LandmarkId| {
+        candidates[i]
+            .iter()
+            .take(REGISTRATION_SEEDS)
+            .any(|c| c.0 == l)
+    };
+    let recent = |l: LandmarkId| frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
+    let registrations: Vec<(&Frame, Registration)> = frames
+        .iter()
+        .filter_map(|frame| Some((frame, register(placed, frame, &alike, &seed)?)))
+        .collect();
+    // A station's only registration is a chance fit of look-alikes when several other frames
+    // hold enough of its landmarks to have found the same pairing and none did.
+    let registrations = match registrations.as_slice() {
+        [(only, registration)]
+            if frames
+                .iter()
+                .filter(|f| !std::ptr::eq(*f, *only) && f.could_confirm(registration))
+                .count()
+                >= SILENT_FRAMES =>
+        {
+            Vec::new()
+        }
+        _ => registrations,
+    };
+    // Registered correspondences of all frames; a detection or landmark given two different
+    // partners by different frames is left out.
+    let mut pairs: Vec<(usize, LandmarkId)> = registrations
+        .iter()
+        .flat_map(|(_, r)| r.pairs.iter().copied())
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    let conflicted =
+        |&(i, l): &(usize, LandmarkId)| pairs.iter().any(|&(j, m)| (j == i) != (m == l));
+    // Frames that hold a landmark but pair it with no detection, or another, doubt the pair.
+    let agreed = |&(i, l): &(usize, LandmarkId)| {
+        let support = registrations
+            .iter()
+            .filter(|(_, r)| r.pairs.contains(&(i, l)))
+            .count();
+        let holding = registrations
+            .iter()
+            .filter(|(frame, _)| frame.landmarks.iter().any(|m| m.0 == l))
+            .count();
+        2 * support > holding
+    };
+    let mut anchors: Vec<(usize, LandmarkId, f64)> = pairs
+        .iter()
+        .filter(|p| !conflicted(p) && agreed(p))
+        .map(|&(i, l)| {
+            let d = candidates[i].iter().find(|c| c.0 == l).map_or(0.0, |c| c.1);
+            (i, l, d)
+        })
+        .collect();
+    // A registered frame also rules out, for each detection, the frame's landmarks that lie
+    // away from where the motion puts it.
+    let candidates: Vec<Vec<(LandmarkId, f64)>> = candidates
+        .into_iter()
+        .enumerate()
+        .map(|(i, list)| {
+            list.into_iter()
+                .filter(|&(l, _)| {
+                    registrations.iter().all(|(frame, r)| {
+                        match (placed[i], frame.landmarks.iter().find(|f| f.0 == l)) {
+                            (Some(p), Some((_, q))) => {
+                                let t = r.to_frame(p.point);
+                                (t[0] - q.point[0]).hypot(t[1] - q.point[1])
+                                    <= p.radius + q.radius + PLACEMENT_SLACK_M
+                            }
+                            _ => true,
+                        }
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    drop_inconsistent_anchors(map, panorama, &mut anchors);
+    let anchored: Vec<(usize, LandmarkId)> = anchors.iter().map(|a| (a.0, a.1)).collect();
+
+    (0..n)
+        .into_par_iter()
+        .map(|i| match anchored.iter().find(|a| a.0 == i) {
+            Some(&(_, landmark)) => Decision::Matched(landmark),
+            None => {
+                let survivors = survivors(
+                    map,
+                    panorama,
+                    i,
+                    &candidates[i],
+                    &anchored,
+                    &recent,
+                    settings,
+                );
+                if survivors.is_empty() {
+                    Decision::New
+                } else {
+                    Decision::HeldBack(survivors)
+                }
+            }
+        })
+        .collect()
+}
+
+/// Re-tests one held-back detection of an earlier station against the current map (000 §VI-C
+/// "delayed until the map has converged further"): the candidates the map still allows, empty
+/// when it rejects them all (a new landmark). `decided` are the other detections of that
+/// station with their landmarks; `None` when they took every candidate, which says nothing
+/// about which rock this one is (a new landmark would duplicate a rock never proposed).
+///
+/// A candidate left alone after the others were rejected is not matched: it is no surer than
+/// a lone pass, since the rock's own landmark need not have been among the look-alikes.
+pub fn reconsider<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    detection: usize,
+    candidates: &[LandmarkId],
+    decided: &[(usize, LandmarkId)],
+    settings: &AssociationSettings,
+) -> Option<Vec<LandmarkId>> {
+    let open: Vec<(LandmarkId, f64)> = candidates
+        .iter()
+        .filter(|l| !decided.iter().any(|d| d.1 == **l))
+        .map(|&l| (l, settings.gate))
+        .collect();
+    if open.is_empty() {
+        return None;
+    }
+    Some(survivors(
+        map,
+        panorama,
+        detection,
+        &open,
+        decided,
+        &|_| true,
+        settings,
+    ))
+}
+
+/// Landmarks whose looks are within the gate, nearest first.
+fn proposals(
+    evidence: &Evidence,
+    gallery: &Gallery,
+    settings: &AssociationSettings,
+) -> Vec<(LandmarkId, f64)> {
+    let mut out: Vec<(LandmarkId, f64)> = gallery
+        .profiles
+        .iter()
+        .filter(|p| match (p.width, evidence.width) {
+            (Some(a), Some(b)) => a.intersection(b).is_some(),
+            _ => true,
+        })
+        .map(|p| {
+            (
+                p.landmark,
+                distance(&evidence.appearance, &p.appearance, &settings.scales),
+            )
+        })
+        .filter(|&(_, d)| d <= settings.gate)
+        .collect();
+    out.sort_by(|a, b| a.1.total_cmp(&b.1));
+    out
+}
+
+/// Whether the measured states of detections `[a, b, c]` overlap the map's relations of
+/// landmarks `ids`, and whether the map constrained them at all. `None` when the map has
+/// nothing on this triple.
+fn triple_consistency<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    detections: [usize; 3],
+    ids: [LandmarkId; 3],
+) -> Option<bool> {
+    let [a, b, c] = ids;
+    let open = [
+        map.relation(a, b, c)?,
+        map.relation(b, c, a)?,
+        map.relation(c, a, b)?,
+    ];
+    if open.iter().all(|r| *r == C::universe()) {
+        return None;
+    }
+    let measured = panorama.measure_triple::<C>(detections, open);
+    Some(measured.iter().all(|r| !r.is_empty()))
+}
+
+/// Drops anchors until every triple of anchors the map knows is consistent.
+fn drop_inconsistent_anchors<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    anchors: &mut Vec<(usize, LandmarkId, f64)>,
+) {
+    loop {
+        let k = anchors.len();
+        let mut failures = vec![0usize; k];
+        for x in 0..k {
+            for y in x + 1..k {
+                for z in y + 1..k {
+                    let (p, q, r) = (anchors[x], anchors[y], anchors[z]);
+                    if triple_consistency(map, panorama, [p.0, q.0, r.0], [p.1, q.1, r.1])
+                        == Some(false)
+                    {
+                        failures[x] += 1;
+                        failures[y] += 1;
+                        failures[z] += 1;
+                    }
+                }
+            }
+        }
+        // The worst offender, the weaker appearance match on ties.
+        let worst = (0..k).filter(|&i| failures[i] > 0).max_by(|&i, &j| {
+            failures[i]
+                .cmp(&failures[j])
+                .then(anchors[i].2.total_cmp(&anchors[j].2))
+        });
+        match worst {
+            Some(i) => {
+                anchors.remove(i);
+            }
+            None => return,
+        }
+    }
+}
+
+/// 000 §VI-C for one detection: the candidates the map does not reject.
+fn survivors<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    detection: usize,
+    candidates: &[(LandmarkId, f64)],
+    anchors: &[(usize, LandmarkId)],
+    recent: &(dyn Fn(LandmarkId) -> bool + Sync),
+    settings: &AssociationSettings,
+) -> Vec<LandmarkId> {
+    let taken = |l: LandmarkId| anchors.iter().any(|a| a.1 == l);
+    candidates
+        .iter()
+        .filter(|c| !taken(c.0))
+        .filter_map(|&(landmark, _)| {
+            let informative =
+                test_candidate(map, panorama, detection, landmark, anchors, settings)?;
+            // A landmark not seen lately stays a candidate only on evidence the map actually
+            // constrains: otherwise every unknown rock would be held back for every old
+            // look-alike, and the map would stop growing.
+            (recent(landmark) || informative >= settings.informative_triples).then_some(landmark)
+        })
+        .collect()
+}
+
+/// `None` if `landmark` is inconsistent with the detection's triples with the anchors;
+/// otherwise the number of triples on which the map constrained the test.
+fn test_candidate<C: Calculus>(
+    map: &Hypergraph<C>,
+    panorama: &Panorama,
+    detection: usize,
+    landmark: LandmarkId,
+    anchors: &[(usize, LandmarkId)],
+    settings: &AssociationSettings,
+) -> Option<usize> {
+    // The pairs on which the map knows most about the candidate first.
+    let mut pairs: Vec<(usize, usize, u32)> = Vec::new();
+    for x in 0..anchors.len() {
+        for y in x + 1..anchors.len() {
+            let (p, q) = (anchors[x], anchors[y]);
+            if let Some(r) = map.relation(landmark, p.1, q.1) {
+                let open = r.len() as u32
+                    + map
+                        .relation(p.1, q.1, landmark)
+                        .map_or(0, |s| s.len() as u32)
+                    + map
+                        .relation(q.1, landmark, p.1)
+                        .map_or(0, |s| s.len() as u32);
+                if open < 3 * C::universe().len() as u32 {
+                    pairs.push((x, y, open));
+                }
+            }
+        }
+    }
+    pairs.sort_by_key(|p| p.2);
+    let mut informative = 0;
+    for &(x, y, _) in pairs.iter().take(settings.tested_pairs) {
+        let (p, q) = (anchors[x], anchors[y]);
+        match triple_consistency(map, panorama, [detection, p.0, q.0], [landmark, p.1, q.1]) {
+            Some(false) => return None,
+            Some(true) => informative += 1,
+            None => {}
+        }
+    }
+    Some(informative)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use qrm_core::edc::Edc;
+    use qrm_core::measurement::{Bearing, RangeOrder};
+    use registration::tests::FIELD;
+
+    fn look() -> Appearance {
+        Appearance {
+            colour: [0.4, 0.33, 0.27],
+            brightness: 1.1,
+            texture: 0.2,
+            dark_fraction: 0.1,
+        }
+    }
+
+    fn at(point: [f64; 2]) -> Placed {
+        Placed { point, radius: 0.3 }
+    }
+
+    /// The station's detections at `points` (bearings from the positions, no range order),
+    /// all alike, with landmarks 0‥6 in the gallery.
+    fn station(points: &[[f64; 2]]) -> (Gallery, Panorama, Vec<Evidence>, Vec<Option<Placed>>) {
+        let mut gallery = Gallery::default();
+        for l in 0..=6 {
+            gallery.observe(l, look(), None);
+        }
+        let bearings = points
+            .iter()
+            .map(|p| Bearing {
+                angle: p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU),
+                uncertainty: 0.01,
+            })
+            .collect();
+        let panorama = Panorama::new(bearings, RangeOrder::unordered(points.len())).unwrap();
+        let evidence = points
+            .iter()
+            .map(|_| Evidence {
+                appearance: look(),
+                width: None,
+            })
+            .collect();
+        let placed = points.iter().map(|&p| Some(at(p))).collect();
+        (gallery, panorama, evidence, placed)
+    }
+
+    /// Associates the station against `frames` on an empty map with default settings.
+    fn associate_station(
+        (gallery, panorama, evidence, placed): &(
+            Gallery,
+            Panorama,
+            Vec<Evidence>,
+            Vec<Option<Placed>>,
+        ),
+        frames: &[Frame],
+    ) -> Vec<Decision> {
+        associate(
+            &Hypergraph::<Edc>::new(),
+            gallery,
+            panorama,
+            evidence,
+            placed,
+            frames,
+            &AssociationSettings::default(),
+        )
+    }
+
+    fn frame(points: &[[f64; 2]]) -> Frame {
+        Frame {
+            landmarks: points
+                .iter()
+                .enumerate()
+                .map(|(l, &p)| (l as LandmarkId, at(p)))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn registered_landmarks_are_matched_and_a_lone_look_alike_is_held_back() {
+        // Landmark 6 lies where the motion puts detection 6, but just as near detection 7 (a
+        // rock of another look): registration leaves it unanchored, placement and the empty
+        // map cannot reject it, and a pass is no evidence.
+        let mut points = FIELD.to_vec();
+        points.extend([[-1.0, 9.0], [-1.5, 9.0]]);
+        let mut station = station(&points);
+        station.2[7].appearance = Appearance {
+            colour: [0.2, 0.3, 0.5],
+            brightness: 3.0,
+            texture: 0.6,
+            dark_fraction: 0.5,
+        };
+        let mut landmarks = FIELD.to_vec();
+        landmarks.push([-1.25, 9.0]);
+        let decisions = associate_station(&station, &[frame(&landmarks)]);
+        for (i, decision) in decisions.iter().take(6).enumerate() {
+            assert_eq!(*decision, Decision::Matched(i as LandmarkId));
+        }
+        assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
+        assert_eq!(decisions[7], Decision::New);
+    }
+
+    #[test]
+    fn a_lone_registration_other_frames_do_not_repeat_anchors_nothing() {
+        // The later frames hold the same landmarks, placed too close together to register.
+        let shrunk = FIELD.map(|p| [0.2 * p[0], 0.2 * p[1]]);
+        let station = station(&FIELD);
+        let two = [frame(&FIELD), frame(&shrunk), frame(&shrunk)];
+        let decisions = associate_station(&station, &two);
+        for (i, decision) in decisions.iter().enumerate() {
+            assert_eq!(*decision, Decision::Matched(i as LandmarkId));
+        }
+        let three = [
+            frame(&FIELD),
+            frame(&shrunk),
+            frame(&shrunk),
+            frame(&shrunk),
+        ];
+        let decisions = associate_station(&station, &three);
+        assert!(
+            decisions.iter().all(|d| !matches!(d, Decision::Matched(_))),
+            "{decisions:?}"
+        );
+    }
+
+    #[test]
+    fn a_pair_most_frames_holding_its_landmark_reject_is_no_anchor() {
+        // Two later frames place landmark 0 far from detection 0: only one of three agrees.
+        let mut moved = FIELD;
+        moved[0] = [-9.0, 9.0];
+        let frames = [frame(&FIELD), frame(&moved), frame(&moved)];
+        let decisions = associate_station(&station(&FIELD), &frames);
+        assert_ne!(decisions[0], Decision::Matched(0));
+        for (i, decision) in decisions.iter().enumerate().skip(1) {
+            assert_eq!(*decision, Decision::Matched(i as LandmarkId));
+        }
+    }
+}

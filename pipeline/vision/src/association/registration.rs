@@ -1,0 +1,359 @@
+//! Association proposals from the layout of the landmarks around a station.
+//!
+//! A station's range intervals and bearings place each detection roughly around the rover
+//! (polar → plane, with a radius covering the interval and the bearing error). Between two
+//! stations the landmarks move by one unknown rotation and translation (no odometry), so the
+//! rigid motion that lines up most look-alike detections with an earlier station's landmarks
+//! proposes who is who. Hypotheses come from every two look-alike correspondences whose
+//! mutual distances agree; the one with most consistent correspondences wins. This only
+//! *proposes*: the qualitative test of 000 §VI-C decides (`super::associate`).
+
+use qrm_core::map::LandmarkId;
+
+/// A point around a station, radius `radius` (metres) of uncertainty.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placed {
+    pub point: [f64; 2],
+    pub radius: f64,
+}
+
+/// The landmarks fused at an earlier station, placed around it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub landmarks: Vec<(LandmarkId, Placed)>,
+}
+
+impl Frame {
+    /// Whether the frame holds enough placed landmarks for a registration to explain.
+    pub fn registrable(&self) -> bool {
+        self.landmarks.len() >= MIN_INLIERS
+    }
+
+    /// Whether the frame holds enough of `registration`'s landmarks to have found the same
+    /// pairing, had it been right.
+    pub fn could_confirm(&self, registration: &Registration) -> bool {
+        registration
+            .pairs
+            .iter()
+            .filter(|(_, l)| self.landmarks.iter().any(|m| m.0 == *l))
+            .count()
+            >= MIN_INLIERS
+    }
+}
+
+/// The correspondences of the best rigid motion: `(detection, landmark)`, and the motion
+/// (`[cos, sin, x, y]`: rotation, then shift) from the current station to the frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Registration {
+    pub pairs: Vec<(usize, LandmarkId)>,
+    pub motion: [f64; 4],
+}
+
+/// Slack added to every distance comparison, metres (rock reference points are not points).
+const SLACK_M: f64 = 0.3;
+/// A partner is unambiguous when every rival lies this many times farther (plus the slack).
+const UNIQUE: f64 = 2.0;
+/// How much better (in fit score) the best motion must be than any different one.
+const MARGIN: f64 = 1.5;
+/// Fewest correspondences a registration must explain to be believed.
+const MIN_INLIERS: usize = 4;
+
+/// The rigid motion from the current station (`current`, by detection) to `frame` explaining
+/// most look-alike correspondences (`alike(detection, landmark)`), if it explains at least
+/// [`MIN_INLIERS`] and clearly more than any motion that differs from it. Motions are
+/// hypothesised only from pairs of the closest look-alikes (`seed`), which keeps the search
+/// quadratic in the detections rather than in all look-alike pairs.
+pub fn register(
+    current: &[Option<Placed>],
+    frame: &Frame,
+    alike: &dyn Fn(usize, LandmarkId) -> bool,
+    seed: &dyn Fn(usize, LandmarkId) -> bool,
+) -> Option<Registration> {
+    let correspondences: Vec<(usize, usize)> = (0..current.len())
+        .filter(|&i| current[i].is_some())
+        .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
+        .filter(|&(i, j)| alike(i, frame.landmarks[j].0))
+        .collect();
+    let seeds: Vec<(usize, usize)> = correspondences
+        .iter()
+        .copied()
+        .filter(|&(i, j)| seed(i, frame.landmarks[j].0))
+        .collect();
+    // Hypotheses scored by how tightly they fit: Σ (1 − (d / tolerance)²) over their
+    // correspondences, so that a loose fit of many does not beat a tight fit of nearly as many.
+    let mut best: Option<(f64, Vec<(usize, usize)>)> = None;
+    let mut runner_up: f64 = 0.0;
+    for (x, &(i1, j1)) in seeds.iter().enumerate() {
+        for &(i2, j2) in &seeds[x + 1..] {
+            if i1 == i2 || j1 == j2 {
+                continue;
+            }
+            let (p1, p2) = (
+                current[i1].expect("filtered"),
+                current[i2].expect("filtered"),
+            );
+            let (q1, q2) = (frame.landmarks[j1].1, frame.landmarks[j2].1);
+            let (dp, dq) = (distance(p1.point, p2.point), distance(q1.point, q2.point));
+            let tolerance = p1.radius + p2.radius + q1.radius + q2.radius + 2.0 * SLACK_M;
+            // Short baselines give a poorly determined rotation.
+            if (dp - dq).abs() > tolerance || dp < tolerance {
+                continue;
+            }
+            let motion = Motion::from_pairs([p1.point, p2.point], [q1.point, q2.point]);
+            let (inliers, score) = matches(current, frame, &motion, &correspondences);
+            match &best {
+                Some((s, pairs)) if score <= *s => {
+                    if !same_assignment(pairs, &inliers) {
+                        runner_up = runner_up.max(score);
+                    }
+                }
+                _ => {
+                    if let Some((s, pairs)) = &best {
+                        if !same_assignment(pairs, &inliers) {
+                            runner_up = runner_up.max(*s);
+                        }
+                    }
+                    best = Some((score, inliers));
+                }
+            }
+        }
+    }
+    let (score, pairs) = best?;
+    let count = pairs.len();
+    if count < MIN_INLIERS || score < runner_up + MARGIN {
+        return None;
+    }
+    // Refit on all inliers, then keep only the correspondences the motion makes unambiguous:
+    // every other landmark of the frame, and every other detection, lies clearly farther.
+    let motion = Motion::fit(
+        &pairs
+            .iter()
+            .map(|&(i, j)| {
+                (
+                    current[i].expect("inlier").point,
+                    frame.landmarks[j].1.point,
+                )
+            })
+            .collect::<Vec<_>>(),
+    );
+    let gap = |i: usize, j: usize| {
+        distance(
+            motion.apply(current[i].expect("placed").point),
+            frame.landmarks[j].1.point,
+        )
+    };
+    let placed: Vec<usize> = (0..current.len())
+        .filter(|&i| current[i].is_some())
+        .collect();
+    let pairs: Vec<(usize, LandmarkId)> = pairs
+        .into_iter()
+        .filter(|&(i, j)| {
+            let d = gap(i, j);
+            let (p, q) = (current[i].expect("placed"), frame.landmarks[j].1);
+            d <= p.radius + q.radius + SLACK_M
+                && (0..frame.landmarks.len()).all(|k| k == j || gap(i, k) > UNIQUE * d + SLACK_M)
+                && placed
+                    .iter()
+                    .all(|&k| k == i || gap(k, j) > UNIQUE * d + SLACK_M)
+        })
+        .map(|(i, j)| (i, frame.landmarks[j].0))
+        .collect();
+    (pairs.len() >= MIN_INLIERS).then(|| Registration {
+        pairs,
+        motion: [motion.cos, motion.sin, motion.shift[0], motion.shift[1]],
+    })
+}
+
+impl Registration {
+    /// Where the current station's point `p` lies in the frame's coordinates.
+    pub fn to_frame(&self, p: [f64; 2]) -> [f64; 2] {
+        let [cos, sin, x, y] = self.motion;
+        Motion {
+            cos,
+            sin,
+            shift: [x, y],
+        }
+        .apply(p)
+    }
+}
+
+/// Whether two correspondence sets mostly agree (the same motion found twice).
+fn same_assignment(a: &[(usize, usize)], b: &[(usize, usize)]) -> bool {
+    let shared = a.iter().filter(|p| b.contains(p)).count();
+    2 * shared >= a.len().min(b.len())
+}
+
+/// A point of the current station and its partner in the frame.
+type PointPair = ([f64; 2], [f64; 2]);
+
+/// Rotation by `angle` then translation.
+struct Motion {
+    cos: f64,
+    sin: f64,
+    shift: [f64; 2],
+}
+
+impl Motion {
+    /// The motion taking `p[0]` onto `q[0]` and the direction `p[0]→p[1]` onto `q[0]→q[1]`.
+    fn from_pairs(p: [[f64; 2]; 2], q: [[f64; 2]; 2]) -> Motion {
+        let angle = (q[1][1] - q[0][1]).atan2(q[1][0] - q[0][0])
+            - (p[1][1] - p[0][1]).atan2(p[1][0] - p[0][0]);
+        let (sin, cos) = angle.sin_cos();
+        let rotated = [cos * p[0][0] - sin * p[0][1], sin * p[0][0] + cos * p[0][1]];
+        Motion {
+            cos,
+            sin,
+            shift: [q[0][0] - rotated[0], q[0][1] - rotated[1]],
+        }
+    }
+
+    /// The least-squares rigid motion taking each `.0` onto its `.1` (2-D Procrustes).
+    fn fit(pairs: &[PointPair]) -> Motion {
+        let n = pairs.len() as f64;
+        let mean = |f: fn(&PointPair) -> [f64; 2]| {
+            let sum = pairs
+                .iter()
+                .map(f)
+                .fold([0.0, 0.0], |a, p| [a[0] + p[0], a[1] + p[1]]);
+            [sum[0] / n, sum[1] / n]
+        };
+        let (mp, mq) = (mean(|p| p.0), mean(|p| p.1));
+        let (mut dot, mut cross) = (0.0, 0.0);
+        for (p, q) in pairs {
+            let (a, b) = ([p[0] - mp[0], p[1] - mp[1]], [q[0] - mq[0], q[1] - mq[1]]);
+            dot += a[0] * b[0] + a[1] * b[1];
+            cross += a[0] * b[1] - a[1] * b[0];
+        }
+        let angle = cross.atan2(dot);
+        let (sin, cos) = angle.sin_cos();
+        let rotated = [cos * mp[0] - sin * mp[1], sin * mp[0] + cos * mp[1]];
+        Motion {
+            cos,
+            sin,
+            shift: [mq[0] - rotated[0], mq[1] - rotated[1]],
+        }
+    }
+
+    fn apply(&self, p: [f64; 2]) -> [f64; 2] {
+        [
+            self.cos * p[0] - self.sin * p[1] + self.shift[0],
+            self.sin * p[0] + self.cos * p[1] + self.shift[1],
+        ]
+    }
+}
+
+/// The one-to-one correspondences (nearest first) that `motion` brings within tolerance, and
+/// the fit score Σ (1 − (d / tolerance)²).
+fn matches(
+    current: &[Option<Placed>],
+    frame: &Frame,
+    motion: &Motion,
+    correspondences: &[(usize, usize)],
+) -> (Vec<(usize, usize)>, f64) {
+    let mut close: Vec<(f64, usize, usize, f64)> = correspondences
+        .iter()
+        .filter_map(|&(i, j)| {
+            let p = current[i].expect("filtered");
+            let q = frame.landmarks[j].1;
+            let d = distance(motion.apply(p.point), q.point);
+            let tolerance = p.radius + q.radius + SLACK_M;
+            (d <= tolerance).then_some((d, i, j, 1.0 - (d / tolerance).powi(2)))
+        })
+        .collect();
+    close.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut used_i = Vec::new();
+    let mut used_j = Vec::new();
+    let mut out = Vec::new();
+    let mut score = 0.0;
+    for (_, i, j, fit) in close {
+        if !used_i.contains(&i) && !used_j.contains(&j) {
+            used_i.push(i);
+            used_j.push(j);
+            out.push((i, j));
+            score += fit;
+        }
+    }
+    (out, score)
+}
+
+fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+
+    /// Six rocks around a station, metres apart (also the association tests' field).
+    pub(in crate::association) const FIELD: [[f64; 2]; 6] = [
+        [3.0, 1.0],
+        [5.0, -2.0],
+        [-4.0, 6.0],
+        [0.5, -7.0],
+        [8.0, 8.0],
+        [-6.0, -3.0],
+    ];
+
+    #[test]
+    fn recovers_who_is_who_after_a_rigid_motion() {
+        let field = FIELD;
+        let (angle, shift) = (0.7f64, [1.5, -0.8]);
+        let frame = Frame {
+            landmarks: field
+                .iter()
+                .enumerate()
+                .map(|(k, p)| {
+                    (
+                        k as LandmarkId + 10,
+                        Placed {
+                            point: *p,
+                            radius: 0.2,
+                        },
+                    )
+                })
+                .collect(),
+        };
+        // The current station sees the landmarks in a shuffled order, moved by the inverse.
+        let order = [4usize, 0, 5, 2, 1, 3];
+        let current: Vec<Option<Placed>> = order
+            .iter()
+            .map(|&k| {
+                let q = field[k];
+                let (x, y) = (q[0] - shift[0], q[1] - shift[1]);
+                let (s, c) = (-angle).sin_cos();
+                Some(Placed {
+                    point: [c * x - s * y, s * x + c * y],
+                    radius: 0.2,
+                })
+            })
+            .collect();
+        let registration =
+            register(&current, &frame, &|_, _| true, &|_, _| true).expect("registers");
+        let mut pairs = registration.pairs.clone();
+        pairs.sort_unstable();
+        let expected: Vec<(usize, LandmarkId)> = order
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| (i, k as LandmarkId + 10))
+            .collect();
+        assert_eq!(pairs, expected);
+    }
+
+    #[test]
+    fn too_few_correspondences_register_nothing() {
+        let frame = Frame {
+            landmarks: vec![(
+                1,
+                Placed {
+                    point: [1.0, 1.0],
+                    radius: 0.1,
+                },
+            )],
+        };
+        let current = vec![Some(Placed {
+            point: [1.0, 1.0],
+            radius: 0.1,
+        })];
+        assert_eq!(register(&current, &frame, &|_, _| true, &|_, _| true), None);
+    }
+}

@@ -1,0 +1,491 @@
+//! Rock detection in one panorama: which blobs below the horizon are rocks, where they touch the
+//! ground (for flat-ground range) and where their centre lies (for bearing), plus an appearance
+//! signature for telling the same rock apart in panoramas taken a few metres apart.
+//!
+//! The ground's brightness and colour depend mainly on the row (haze grows with range), so the
+//! background is modelled per row by medians, which rocks (a small fraction of any row) do not
+//! move. Rock pixels differ from regolith in chroma (rocks are greyer than the red soil), or are
+//! much brighter; cast shadows are darker but keep the regolith's red hue, so they are left out
+//! and cannot drag the contact row or centroid. Small blobs are rejected by physical width at
+//! the flat-ground range of their contact row, which removes pebbles at every resolution.
+
+mod components;
+mod parallax;
+mod split;
+
+use crate::calib::Calibration;
+use components::{blob_of, label_wrapped, Blob};
+use kornia_image::{Image, ImageSize};
+pub use parallax::{ParallaxRule, Separation};
+use serde::{Deserialize, Serialize};
+
+/// Thresholds of the detector. Ratios are relative to the row's median regolith.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DetectorSettings {
+    /// Narrowest rock kept, metres of visible width at the contact range (pebbles are ≤ 8 cm).
+    pub min_width_m: f64,
+    /// Farthest rock kept, metres of flat-ground range at the contact row.
+    pub max_range_m: f64,
+    /// A blob whose luminance varies less than this (standard deviation over mean) and which is
+    /// within `bright_ratio` of the regolith's brightness either way is a tint of the ground
+    /// (a dust drift just greyer than the row's median), not a rock: rocks are faceted and
+    /// shaded on one side, or differ in brightness.
+    pub min_texture: f32,
+    /// A blob whose top edge, read as flat ground, lies less than this many of its widths
+    /// beyond its contact is a patch lying on the ground (pebbles, clumps of them), not a rock
+    /// standing up from it: a flat patch as deep as it is wide reaches 1, any rock of that
+    /// width rises higher in the image.
+    pub min_rise: f64,
+    /// A pixel whose `(r − b)/(r + g + b)` is this much below its row's median is rock: rocks
+    /// are greyer than the red regolith, in sun and in shade alike.
+    pub chroma_drop: f32,
+    /// A pixel this many times brighter than its row's median is rock (shadows never are).
+    pub bright_ratio: f32,
+    /// A pixel darker than this fraction of its row's median is rock if it is also greyer by
+    /// `dark_chroma_drop`: the shaded side of a rock, told from cast shadows (which stay red).
+    pub dark_ratio: f32,
+    pub dark_chroma_drop: f32,
+    /// A blob is cut where its bottom edge lies this many rows (at least) under the concave
+    /// hull of its bottom edge: one rock's bottom edge is concave, touching rocks notch it.
+    /// Small blobs need a shallow cut: two touching pebbles notch each other by a couple of
+    /// rows, and each half is then too narrow to keep.
+    pub split_depth_px: f32,
+    /// … or this fraction of the blob's height, if more (ragged edges grow with size).
+    pub split_depth_fraction: f32,
+    /// When a blob holding a nearer and a farther rock is separated by stereo parallax.
+    pub parallax: ParallaxRule,
+}
+
+impl Default for DetectorSettings {
+    fn default() -> Self {
+        DetectorSettings {
+            min_width_m: 0.12,
+            max_range_m: 30.0,
+            min_rise: 0.9,
+            min_texture: 0.04,
+            chroma_drop: 0.035,
+            bright_ratio: 1.25,
+            dark_ratio: 0.6,
+            dark_chroma_drop: 0.02,
+            split_depth_px: 2.0,
+            split_depth_fraction: 0.15,
+            parallax: ParallaxRule {
+                radius: 2,
+                min_pixels: 60,
+                min_step_px: 1.0,
+                min_step_fraction: 0.05,
+                step_ratio: 0.4,
+                min_depth_halfwidths: 1.0,
+                min_share: 0.05,
+                min_fragment: 30,
+                sliver_fraction: 0.1,
+            },
+        }
+    }
+}
+
+/// One rock-like blob in one panorama.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Detection {
+    /// Mean continuous (column, row) of the rock pixels, pixel centres at `+0.5`; the column in
+    /// `[0, width)`.
+    pub centroid: [f64; 2],
+    /// `[col_min, row_min, col_max, row_max]`, inclusive; `col_max ≥ width` when the blob
+    /// straddles the seam.
+    pub bbox: [u32; 4],
+    /// Rock pixels (shadow excluded).
+    pub pixels: u32,
+    /// Continuous row of the bottom edge of the rock itself (its ground contact).
+    pub contact_row: f64,
+    pub appearance: Appearance,
+    /// May be several rocks (its bottom edge is notched, but too shallowly to cut), or only the
+    /// visible part of a rock cut from a nearer one in front of it: do not use its bearing.
+    pub ambiguous: bool,
+    /// Whether parallax separated this blob from another part, and which part it is.
+    #[serde(default)]
+    pub separation: Separation,
+    /// The connected blob of the mask this detection was cut from: pieces of one blob share it.
+    #[serde(default)]
+    pub blob: u32,
+}
+
+/// Statistics that change little with viewpoint, for associating a rock across panoramas.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Appearance {
+    /// Mean chromaticity (r, g, b summing to 1).
+    pub colour: [f32; 3],
+    /// Rock luminance over the regolith's median luminance at the same rows.
+    pub brightness: f32,
+    /// Luminance standard deviation over mean, inside the rock.
+    pub texture: f32,
+    /// Fraction of the rock's pixels darker than `dark_ratio` of the regolith: its shaded side.
+    pub dark_fraction: f32,
+}
+
+/// Detects rocks in `image`, sorted by centroid column. Given the right panorama of its
+/// stereo pair (`image` being the left), blobs of a nearer and a farther rock are also
+/// separated by parallax. An image whose size differs from the calibration's yields no
+/// detections (its geometry would be meaningless); a right panorama of another size is ignored.
+pub fn detect(
+    image: &image::RgbImage,
+    right: Option<&image::RgbImage>,
+    calib: &Calibration,
+    settings: &DetectorSettings,
+) -> Vec<Detection> {
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    if image.width() != calib.image.width || image.height() != calib.image.height || w == 0 {
+        return Vec::new();
+    }
+    let top = (calib.elevation.horizon_row.floor().max(0.0) as usize).min(h);
+    let rows = h - top;
+    if rows == 0 {
+        return Vec::new();
+    }
+    let raw = &image.as_raw()[top * w * 3..];
+    let background = row_medians(raw, w);
+    let mut mask = segment(raw, &background, w, settings);
+    close3(&mut mask, w);
+    let Ok(mask) = Image::<u8, 1>::new(
+        ImageSize {
+            width: w,
+            height: rows,
+        },
+        mask,
+    ) else {
+        return Vec::new();
+    };
+    let sample = |col: usize, row: usize| {
+        let i = row * w + col;
+        let p = &raw[3 * i..3 * i + 3];
+        let sum = f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2]);
+        let ratio = sum / background[row].0.max(1.0);
+        PixelSample {
+            rgb: [f32::from(p[0]), f32::from(p[1]), f32::from(p[2])],
+            ratio,
+            dark: ratio < settings.dark_ratio,
+        }
+    };
+    let rule = split::SplitRule {
+        min_depth: settings.split_depth_px,
+        fraction: settings.split_depth_fraction,
+        min_columns: 3,
+    };
+    let luminance = |img: &image::RgbImage| -> Vec<u16> {
+        img.as_raw()[top * w * 3..]
+            .chunks_exact(3)
+            .map(|p| u16::from(p[0]) + u16::from(p[1]) + u16::from(p[2]))
+            .collect()
+    };
+    let bands = right
+        .filter(|r| r.dimensions() == image.dimensions() && calib.stereo.baseline_m > 0.0)
+        .map(|r| (luminance(image), luminance(r)));
+    // The right camera sees a point turned towards increasing azimuth.
+    let partner = bands.as_ref().map(|(own, other)| parallax::Partner {
+        own,
+        other,
+        width: w,
+        rows,
+        direction: if calib.column_sign() > 0.0 { 1 } else { -1 },
+        column_width: calib.column_width(),
+        baseline_m: calib.stereo.baseline_m,
+    });
+    // The search reaches the shift of a rock somewhat nearer than the blob's lowest row reads
+    // on flat ground (a rock's face overhangs its foot); a blob cut off by the image's bottom
+    // may hold a rock nearer still.
+    let max_shift = |pixels: &components::Component| -> usize {
+        let bottom = pixels.iter().map(|p| p.1 as usize).max().unwrap_or(0);
+        let margin = if bottom + 1 >= rows { 0.5 } else { 0.8 };
+        let nearest = calib
+            .ground_range((bottom + top + 1) as f64)
+            .map(|r| (margin * r).max(0.5));
+        nearest.map_or(0, |range| {
+            (calib.stereo_disparity(range) / calib.column_width()).ceil() as usize + 3
+        })
+    };
+    let mut detections: Vec<Detection> = label_wrapped(&mask, w, rows)
+        .into_iter()
+        .enumerate()
+        .flat_map(|(blob, c)| {
+            let layers = match &partner {
+                Some(partner) => {
+                    let shift = max_shift(&c);
+                    parallax::layers(c, partner, shift, settings.parallax)
+                }
+                None => vec![parallax::Layer {
+                    pixels: c,
+                    part: Separation::Whole,
+                }],
+            };
+            layers.into_iter().map(move |layer| (blob as u32, layer))
+        })
+        .flat_map(|(blob, layer)| {
+            // A farther layer's bottom edge is the nearer rock's outline, notched where that
+            // outline rises: the notch rule would cut the farther rock in two.
+            let pieces = if layer.part == Separation::Farther {
+                vec![split::Piece {
+                    pixels: layer.pixels,
+                    ambiguous: true,
+                }]
+            } else {
+                split::split(layer.pixels, rule)
+            };
+            pieces
+                .into_iter()
+                .map(move |piece| (blob, piece, layer.part))
+        })
+        .filter_map(|(blob, piece, part)| {
+            let pixels = blob_of(&piece.pixels, w, &sample);
+            let mut detection = accept(pixels, piece.ambiguous, top, calib, settings)?;
+            detection.separation = part;
+            detection.blob = blob;
+            Some(detection)
+        })
+        .collect();
+    detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
+    detections
+}
+
+/// What a blob accumulates of each of its pixels for its appearance.
+struct PixelSample {
+    rgb: [f32; 3],
+    /// Luminance over the row's median.
+    ratio: f32,
+    /// Darker than `dark_ratio` of the row's median.
+    dark: bool,
+}
+
+/// Luminance `r + g + b` and redness `(r − b)/(r + g + b)` of a pixel.
+fn luminance_redness(p: &[u8]) -> (f32, f32) {
+    let s = f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2]);
+    (s, (f32::from(p[0]) - f32::from(p[2])) / (s + 1.0))
+}
+
+/// Median luminance and redness of each row, from every fourth column at most (rocks cover a
+/// small part of any row; the sample keeps the medians cheap).
+fn row_medians(raw: &[u8], w: usize) -> Vec<(f32, f32)> {
+    let step = if w >= 1024 { 4 } else { 1 };
+    let mut sums = Vec::with_capacity(w / step + 1);
+    let mut reds = Vec::with_capacity(w / step + 1);
+    raw.chunks_exact(3 * w)
+        .map(|row| {
+            sums.clear();
+            reds.clear();
+            for p in row.chunks_exact(3).step_by(step) {
+                let (s, r) = luminance_redness(p);
+                sums.push(s);
+                reds.push(r);
+            }
+            let mid = sums.len() / 2;
+            (
+                *sums.select_nth_unstable_by(mid, f32::total_cmp).1,
+                *reds.select_nth_unstable_by(mid, f32::total_cmp).1,
+            )
+        })
+        .collect()
+}
+
+/// Rock pixels (255) of the ground band, tested without divisions: `ratio > k` as
+/// `sum > k · median`, a redness drop as `(median − t)(sum + 1) > r − b`.
+fn segment(raw: &[u8], background: &[(f32, f32)], w: usize, s: &DetectorSettings) -> Vec<u8> {
+    let rows = background.len();
+    let mut mask = vec![0u8; w * rows];
+    for ((row, out), &(bg_sum, bg_red)) in raw
+        .chunks_exact(3 * w)
+        .zip(mask.chunks_exact_mut(w))
+        .zip(background)
+    {
+        let bright = s.bright_ratio * bg_sum;
+        let dark = s.dark_ratio * bg_sum;
+        let grey = bg_red - s.chroma_drop;
+        let dark_grey = bg_red - s.dark_chroma_drop;
+        for (p, m) in row.chunks_exact(3).zip(out.iter_mut()) {
+            let sum = f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2]);
+            let red = f32::from(p[0]) - f32::from(p[2]);
+            let scale = sum + 1.0;
+            let rock =
+                red < grey * scale || sum > bright || (sum < dark && red < dark_grey * scale);
+            *m = if rock { 255 } else { 0 };
+        }
+    }
+    mask
+}
+
+/// Morphological closing of `mask` (`w` wide) by a 3 × 3 square, the neighbourhood clipped at
+/// the image's edges: it bridges one-pixel cracks inside rocks. Separable u8 max/min passes,
+/// several times faster than a distance transform.
+fn close3(mask: &mut [u8], w: usize) {
+    let mut tmp = vec![0u8; mask.len()];
+    along_rows(mask, &mut tmp, w, u8::max);
+    along_columns(&tmp, mask, w, u8::max);
+    along_rows(mask, &mut tmp, w, u8::min);
+    along_columns(&tmp, mask, w, u8::min);
+}
+
+/// `out[x] = f(input[x − 1], input[x], input[x + 1])` within each row, edges clipped.
+fn along_rows(input: &[u8], out: &mut [u8], w: usize, f: fn(u8, u8) -> u8) {
+    for (row, o) in input.chunks_exact(w).zip(out.chunks_exact_mut(w)) {
+        o[0] = f(row[0], row[1.min(w - 1)]);
+        for (x, win) in row.windows(3).enumerate() {
+            o[x + 1] = f(f(win[0], win[1]), win[2]);
+        }
+        if w > 1 {
+            o[w - 1] = f(row[w - 2], row[w - 1]);
+        }
+    }
+}
+
+/// `out[y] = f(input[y − 1], input[y], input[y + 1])` within each column, edges clipped.
+fn along_columns(input: &[u8], out: &mut [u8], w: usize, f: fn(u8, u8) -> u8) {
+    let rows = input.len() / w;
+    for y in 0..rows {
+        let centre = &input[y * w..(y + 1) * w];
+        let above = &input[y.saturating_sub(1) * w..][..w];
+        let below = &input[(y + 1).min(rows - 1) * w..][..w];
+        let o = &mut out[y * w..(y + 1) * w];
+        for (((o, &a), &c), &b) in o.iter_mut().zip(above).zip(centre).zip(below) {
+            *o = f(f(a, c), b);
+        }
+    }
+}
+
+/// The detection of `blob` (band rows offset by `top`), or `None` if it is empty, its contact
+/// row is at or above the horizon, it is narrower than `min_width_m` or farther than
+/// `max_range_m`, or it lies flat on the ground (`min_rise`) or is a tint of it (`min_texture`).
+fn accept(
+    blob: Blob,
+    ambiguous: bool,
+    top: usize,
+    calib: &Calibration,
+    settings: &DetectorSettings,
+) -> Option<Detection> {
+    if blob.pixels == 0 || blob.col_max < blob.col_min {
+        return None;
+    }
+    let n = f64::from(blob.pixels);
+    let contact_row = (blob.row_max + top + 1) as f64;
+    let range = calib.ground_range(contact_row)?;
+    let width_px = (blob.col_max - blob.col_min + 1) as f64;
+    let width_m = width_px * calib.column_width() * range;
+    let top_row = (blob.row_min + top) as f64;
+    let clipped = contact_row >= f64::from(calib.image.height);
+    let appearance = appearance_of(&blob);
+    if range > settings.max_range_m
+        || width_m < settings.min_width_m
+        || (!clipped && lies_flat(top_row, range, width_m, calib, settings.min_rise))
+        || ground_tint(&appearance, settings)
+    {
+        return None;
+    }
+    let width = f64::from(calib.image.width);
+    Some(Detection {
+        centroid: [
+            (blob.sum_col / n).rem_euclid(width),
+            blob.sum_row / n + top as f64,
+        ],
+        bbox: [
+            blob.col_min as u32,
+            (blob.row_min + top) as u32,
+            blob.col_max as u32,
+            (blob.row_max + top) as u32,
+        ],
+        pixels: blob.pixels,
+        contact_row,
+        appearance,
+        ambiguous,
+        separation: Separation::Whole,
+        blob: 0,
+    })
+}
+
+/// The appearance statistics of a non-empty `blob`.
+fn appearance_of(blob: &Blob) -> Appearance {
+    let n = f64::from(blob.pixels);
+    let mean_luminance = blob.sum_luminance / n;
+    let variance = (blob.sum_luminance_sq / n - mean_luminance * mean_luminance).max(0.0);
+    let total: f64 = blob.sum_rgb.iter().sum::<f64>().max(1.0);
+    Appearance {
+        colour: blob.sum_rgb.map(|c| (c / total) as f32),
+        brightness: (blob.sum_ratio / n) as f32,
+        texture: (variance.sqrt() / mean_luminance.max(1.0)) as f32,
+        dark_fraction: (f64::from(blob.dark) / n) as f32,
+    }
+}
+
+/// Whether a blob looks like regolith of another tint: as bright as the ground (within
+/// `bright_ratio` either way) and smoother than `min_texture`.
+fn ground_tint(a: &Appearance, s: &DetectorSettings) -> bool {
+    a.texture < s.min_texture
+        && a.brightness * s.bright_ratio > 1.0
+        && a.brightness < s.bright_ratio
+}
+
+/// Whether a blob from `top_row` down to a contact at `range` (metres), `width_m` wide, is no
+/// taller than flat ground `min_rise × width_m` deep: its top edge, read as ground, lies less
+/// than that beyond the contact. A blob reaching the horizon stands up.
+fn lies_flat(top_row: f64, range: f64, width_m: f64, calib: &Calibration, min_rise: f64) -> bool {
+    calib
+        .ground_range(top_row)
+        .is_some_and(|far| far - range < min_rise * width_m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{close3, ground_tint, lies_flat, Appearance, DetectorSettings};
+    use crate::calib::Calibration;
+
+    /// A smooth blob as bright as the regolith is a tint of it; a textured one, or a smooth
+    /// one clearly darker or brighter, may be a rock.
+    #[test]
+    fn smooth_ground_bright_blobs_are_tints() {
+        let s = DetectorSettings::default();
+        let blob = |brightness, texture| Appearance {
+            colour: [0.4, 0.33, 0.27],
+            brightness,
+            texture,
+            dark_fraction: 0.0,
+        };
+        assert!(ground_tint(&blob(1.05, 0.01), &s));
+        assert!(!ground_tint(&blob(1.05, 0.1), &s));
+        assert!(!ground_tint(&blob(0.7, 0.01), &s));
+        assert!(!ground_tint(&blob(1.3, 0.01), &s));
+    }
+
+    /// From the 1.5 m mast at 4 m: a patch on the ground 0.2 m wide and 0.1 m deep lies flat;
+    /// a rock as wide and 0.1 m tall rises above it.
+    #[test]
+    fn flat_patches_lie_flat_and_rocks_rise() {
+        let calib =
+            Calibration::parse(include_str!("../../../../calib/default.toml"), "default").unwrap();
+        let patch_top = calib.ground_row(4.1);
+        assert!(lies_flat(patch_top, 4.0, 0.2, &calib, 0.9));
+        let rock_top = calib.row((0.1f64 - 1.5).atan2(4.0));
+        assert!(!lies_flat(rock_top, 4.0, 0.2, &calib, 0.9));
+        assert!(!lies_flat(
+            calib.elevation.horizon_row,
+            4.0,
+            0.2,
+            &calib,
+            0.9
+        ));
+    }
+
+    /// A one-pixel crack inside a blob is bridged; the blob does not grow, even at the edge.
+    #[test]
+    fn closing_bridges_cracks_without_growing() {
+        let w = 8;
+        let mut mask = vec![0u8; w * 6];
+        for y in 0..4 {
+            for x in 0..5 {
+                if x != 2 {
+                    mask[y * w + x] = 255;
+                }
+            }
+        }
+        let mut expected = vec![0u8; w * 6];
+        for y in 0..4 {
+            expected[y * w..y * w + 5].fill(255);
+        }
+        close3(&mut mask, w);
+        assert_eq!(mask, expected);
+    }
+}

@@ -1,0 +1,429 @@
+//! Bearings and range evidence of one station's detections (000 §IV assumptions 1–2), and the
+//! partial range order they support.
+//!
+//! Three cues bound each landmark's horizontal range from the station centre, each with an
+//! interval that covers the truth within the [`SensorModel`]:
+//! - **flat ground**: the row of the ground contact gives the range of the rock's near edge;
+//!   its reference point lies beyond that by at most a fraction of its apparent width;
+//! - **stereo parallax**: the azimuth difference between the left and right panoramas of the
+//!   rotating head, `2·asin(b / 2d)` ([`Calibration::stereo_range`]);
+//! - **apparent size**: once a landmark's physical width is bounded by earlier stations, its
+//!   apparent width bounds its range (sizes are only compared with the same rock's).
+//!
+//! The fused interval is their intersection; "A nearer than B" is asserted only when A's
+//! interval lies entirely below B's, so the order is partial where the evidence is weak.
+
+mod interval;
+mod stereo;
+
+pub use interval::RangeInterval;
+pub use stereo::match_stereo;
+
+use crate::calib::Calibration;
+use crate::detection::{Detection, Separation};
+use qrm_core::measurement::{Bearing, RangeOrder};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{PI, TAU};
+
+/// The error bounds of the vision front end: every interval it produces is widened by these.
+/// The defaults are calibrated on the synthetic presets (`docs/RUN.md`, "Figures", gives how
+/// often the measured errors stay inside them).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SensorModel {
+    /// Bearing error of a centroid: `px + per_width × apparent width`, in columns. The
+    /// centroid of a silhouette moves with the viewpoint by a fraction of the rock's width.
+    pub bearing_error_px: f64,
+    pub bearing_error_per_width: f64,
+    /// Error of the contact row, rows.
+    pub contact_error_px: f64,
+    /// How far beyond its ground contact the landmark's reference point may lie, as a multiple
+    /// of its apparent physical width.
+    pub reach_per_width: f64,
+    /// Error of a left–right azimuth difference: `px + per_width × apparent width`, columns.
+    pub disparity_error_px: f64,
+    pub disparity_error_per_width: f64,
+    /// Factor by which a rock's apparent width may differ from its reference width at any
+    /// viewpoint: applied when a view bounds the reference width and again when the reference
+    /// bounds another view's range, so two views may differ by its square.
+    pub size_change: f64,
+    /// Nearest range at which rocks are looked for in the right panorama, metres.
+    pub min_range_m: f64,
+}
+
+impl Default for SensorModel {
+    fn default() -> SensorModel {
+        SensorModel {
+            bearing_error_px: 1.5,
+            bearing_error_per_width: 0.15,
+            contact_error_px: 1.5,
+            reach_per_width: 0.75,
+            disparity_error_px: 1.5,
+            disparity_error_per_width: 0.1,
+            size_change: 1.6,
+            min_range_m: 0.5,
+        }
+    }
+}
+
+/// Which camera took the primary panorama: bearings from an eye of the rotating stereo head
+/// are offset from the station centre by `asin(b / 2d)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PrimaryEye {
+    Mono,
+    Left,
+}
+
+/// Bearing and range evidence for one detection of the primary panorama.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ranged {
+    /// Bearing from the station centre, radians counter-clockwise.
+    pub bearing: Bearing,
+    /// Centroid column of the matched right-panorama detection.
+    pub stereo_column: Option<f64>,
+    /// Apparent width, radians of azimuth.
+    pub angular_width: f64,
+    pub ground: Option<RangeInterval>,
+    pub stereo: Option<RangeInterval>,
+    pub size: Option<RangeInterval>,
+    pub fused: RangeInterval,
+    /// The cues did not overlap: `fused` is their hull and no cue is trusted over another.
+    pub conflict: bool,
+}
+
+/// Bearings and the flat-ground and stereo cues of `primary` (with `right` for stereo
+/// stations). Pure: the same detections always give the same evidence.
+pub fn observe(
+    primary: &[Detection],
+    right: Option<&[Detection]>,
+    eye: PrimaryEye,
+    calib: &Calibration,
+    model: &SensorModel,
+) -> Vec<Ranged> {
+    let matches = match right {
+        Some(right) if eye == PrimaryEye::Left => match_stereo(primary, right, calib, model),
+        _ => vec![None; primary.len()],
+    };
+    let half_baseline = match eye {
+        PrimaryEye::Mono => 0.0,
+        PrimaryEye::Left => 0.5 * calib.stereo.baseline_m,
+    };
+    primary
+        .iter()
+        .enumerate()
+        .map(|(i, d)| {
+            let columns = apparent_columns(d);
+            let angular_width = columns * calib.column_width();
+            let ground = ground_cue(d, i, primary, calib, model, angular_width, half_baseline);
+            let right_detection = matches[i].zip(right).map(|(j, r)| &r[j]);
+            let stereo = right_detection.map(|r| stereo_cue(d, r, calib, model));
+            let (fused, conflict) = fuse([ground, stereo, None]);
+            let bearing = bearing_of(d, right_detection, calib, model, half_baseline, fused);
+            Ranged {
+                bearing,
+                stereo_column: right_detection.map(|r| r.centroid[0]),
+                angular_width,
+                ground,
+                stereo,
+                size: None,
+                fused,
+                conflict,
+            }
+        })
+        .collect()
+}
+
+/// Adds the apparent-size cue from a physical width interval known from earlier stations.
+pub fn apply_size(ranged: &mut Ranged, width: RangeInterval, model: &SensorModel) {
+    if ranged.angular_width <= 0.0 {
+        return;
+    }
+    let size = RangeInterval::new(
+        width.low / (model.size_change * ranged.angular_width),
+        width.high * model.size_change / ranged.angular_width,
+    );
+    ranged.size = Some(size);
+    let (fused, conflict) = fuse([ranged.ground, ranged.stereo, ranged.size]);
+    ranged.fused = fused;
+    ranged.conflict = conflict;
+}
+
+/// The physical width this detection implies for its rock, widened by the viewpoint factor so
+/// that intervals from different stations can be intersected: only ground and stereo evidence
+/// count, so the size cue never feeds itself.
+pub fn width_evidence(ranged: &Ranged, model: &SensorModel) -> Option<RangeInterval> {
+    let (fused, conflict) = fuse([ranged.ground, ranged.stereo, None]);
+    (!conflict && fused.high.is_finite() && ranged.angular_width > 0.0).then(|| {
+        RangeInterval::new(
+            fused.low * ranged.angular_width / model.size_change,
+            fused.high * ranged.angular_width * model.size_change,
+        )
+    })
+}
+
+/// "Nearer than" wherever the fused intervals separate (000 §IV assumption 2, partial).
+pub fn range_order(ranged: &[Ranged]) -> RangeOrder {
+    let pairs: Vec<(usize, usize)> = (0..ranged.len())
+        .flat_map(|i| (0..ranged.len()).map(move |j| (i, j)))
+        .filter(|&(i, j)| i != j && ranged[i].fused.entirely_below(ranged[j].fused))
+        .collect();
+    RangeOrder::from_pairs(ranged.len(), &pairs)
+        .expect("interval separation is a strict order: irreflexive and transitive")
+}
+
+/// Width of a detection in columns (its bbox, wrap-aware).
+fn apparent_columns(d: &Detection) -> f64 {
+    f64::from(d.bbox[2].saturating_sub(d.bbox[0]) + 1)
+}
+
+/// Intersection of the cues that apply; their hull (flagged) if they disagree.
+fn fuse(cues: [Option<RangeInterval>; 3]) -> (RangeInterval, bool) {
+    let mut present = cues.into_iter().flatten();
+    let Some(first) = present.next() else {
+        return (RangeInterval::unbounded(), false);
+    };
+    let rest: Vec<RangeInterval> = present.collect();
+    let intersection = rest.iter().try_fold(first, |acc, &c| acc.intersection(c));
+    match intersection {
+        Some(fused) => (fused, false),
+        None => (rest.iter().fold(first, |acc, &c| acc.hull(c)), true),
+    }
+}
+
+/// Flat-ground cue (000 §IV: flat ground, mast height known). `None` if the contact is at or
+/// above the horizon, below the image, or may be hidden behind a nearer detection (then the
+/// visible bottom is not the contact).
+fn ground_cue(
+    d: &Detection,
+    index: usize,
+    all: &[Detection],
+    calib: &Calibration,
+    model: &SensorModel,
+    angular_width: f64,
+    half_baseline: f64,
+) -> Option<RangeInterval> {
+    // Cut off by the bottom edge: the contact is not in the picture.
+    if d.bbox[3] + 1 >= calib.image.height || contact_hidden(index, all, calib.image.width) {
+        return None;
+    }
+    let near = calib.ground_range(d.contact_row + model.contact_error_px)?;
+    let far = calib.ground_range(d.contact_row - model.contact_error_px)?;
+    // Range from the eye along the view, then from the station centre (the eye sits half a
+    // baseline across the view).
+    let centre = |r: f64| r.hypot(half_baseline);
+    // The reference point lies beyond the contact by ≤ reach·width, and the width itself
+    // grows with range: width ≤ angular_width · range.
+    let k = model.reach_per_width * angular_width;
+    if k >= 1.0 {
+        return None;
+    }
+    Some(RangeInterval::new(centre(near), centre(far) / (1.0 - k)))
+}
+
+/// Whether detection `index` touches another one side by side (columns within two of each
+/// other, rows overlapping): the two may be pieces of one rock, or two rocks cut apart where
+/// they touch, and either way its centroid may be far from its rock's centre. The nearer part
+/// of a blob separated by parallax is not doubted for touching a farther part of the same
+/// blob: the edge between them is its own outline.
+pub fn touches_neighbour(index: usize, all: &[Detection], width: u32) -> bool {
+    let me = &all[index];
+    all.iter().enumerate().any(|(j, other)| {
+        j != index
+            && !(me.separation == Separation::Nearer
+                && other.separation == Separation::Farther
+                && other.blob == me.blob)
+            && columns_overlap(me.bbox, other.bbox, 2, width)
+            && other.bbox[1] <= me.bbox[3]
+            && me.bbox[1] <= other.bbox[3]
+    })
+}
+
+/// Whether another detection overlaps `index`'s columns and reaches down to or below its
+/// contact row: a nearer rock may hide the true contact.
+fn contact_hidden(index: usize, all: &[Detection], width: u32) -> bool {
+    let me = &all[index];
+    all.iter().enumerate().any(|(j, other)| {
+        j != index
+            && columns_overlap(me.bbox, other.bbox, 2, width)
+            && other.contact_row > me.contact_row
+            && f64::from(other.bbox[1]) <= me.contact_row + 2.0
+    })
+}
+
+/// Whether two wrap-aware column spans of a `width`-column panorama overlap, with `slack`
+/// columns of tolerance.
+fn columns_overlap(a: [u32; 4], b: [u32; 4], slack: u32, width: u32) -> bool {
+    let span = |x: [u32; 4]| (i64::from(x[0]), i64::from(x[2]));
+    let (a0, a1) = span(a);
+    let (b0, b1) = span(b);
+    let slack = i64::from(slack);
+    // Compare in both unwrappings: a span may have col_max ≥ width.
+    let overlap = |s: i64| a0 - slack <= b1 + s && b0 + s <= a1 + slack;
+    let width = i64::from(width);
+    overlap(0) || overlap(width) || overlap(-width)
+}
+
+/// Stereo cue from the left (`d`) and right (`r`) detections of one rock.
+fn stereo_cue(
+    d: &Detection,
+    r: &Detection,
+    calib: &Calibration,
+    model: &SensorModel,
+) -> RangeInterval {
+    let disparity = azimuth_difference(calib.azimuth(r.centroid[0]), calib.azimuth(d.centroid[0]));
+    let columns = 0.5 * (apparent_columns(d) + apparent_columns(r));
+    let error = (model.disparity_error_px + model.disparity_error_per_width * columns)
+        * calib.column_width();
+    let near = calib.stereo_range(disparity + error).unwrap_or(0.0);
+    let far = calib
+        .stereo_range(disparity - error)
+        .unwrap_or(f64::INFINITY);
+    RangeInterval::new(near, far)
+}
+
+/// Bearing from the station centre. Left eye: α_L = φ − asin(b/2d) and α_R = φ + asin(b/2d),
+/// so a stereo pair gives φ as their mean; a lone left detection gives φ within the offsets
+/// its range interval allows.
+fn bearing_of(
+    d: &Detection,
+    right: Option<&Detection>,
+    calib: &Calibration,
+    model: &SensorModel,
+    half_baseline: f64,
+    range: RangeInterval,
+) -> Bearing {
+    let left = calib.azimuth(d.centroid[0]);
+    let error = (model.bearing_error_px + model.bearing_error_per_width * apparent_columns(d))
+        * calib.column_width();
+    let (angle, spread) = match right {
+        Some(r) => {
+            let difference = azimuth_difference(calib.azimuth(r.centroid[0]), left);
+            (left + 0.5 * difference, 0.0)
+        }
+        None if half_baseline > 0.0 => {
+            let offset = |range: f64| (half_baseline / range.max(half_baseline)).asin();
+            let (small, large) = (offset(range.high), offset(range.low.max(half_baseline)));
+            (left + 0.5 * (small + large), 0.5 * (large - small))
+        }
+        None => (left, 0.0),
+    };
+    Bearing {
+        angle: angle.rem_euclid(TAU),
+        uncertainty: error + spread,
+    }
+}
+
+/// `a − b` wrapped into `(−π, π]`.
+fn azimuth_difference(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(TAU);
+    if d > PI {
+        d - TAU
+    } else {
+        d
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::detection::Appearance;
+
+    fn blob(bbox: [u32; 4], separation: Separation) -> Detection {
+        Detection {
+            centroid: [
+                f64::from(bbox[0] + bbox[2]) / 2.0,
+                f64::from(bbox[1] + bbox[3]) / 2.0,
+            ],
+            bbox,
+            pixels: 100,
+            contact_row: f64::from(bbox[3] + 1),
+            appearance: Appearance {
+                colour: [0.4, 0.33, 0.27],
+                brightness: 0.8,
+                texture: 0.1,
+                dark_fraction: 0.2,
+            },
+            ambiguous: separation == Separation::Farther,
+            separation,
+            blob: 7,
+        }
+    }
+
+    /// Two blobs side by side doubt each other; the nearer part of a parallax separation is not
+    /// doubted for touching its own blob's farther part, though the farther part still is, and
+    /// the nearer part still is for touching anything else.
+    #[test]
+    fn touching_doubts_all_but_a_nearer_part_against_a_farther_one() {
+        let width = 4096;
+        let whole = [
+            blob([100, 50, 120, 70], Separation::Whole),
+            blob([121, 52, 140, 72], Separation::Whole),
+        ];
+        assert!(touches_neighbour(0, &whole, width) && touches_neighbour(1, &whole, width));
+        let separated = [
+            blob([100, 60, 140, 80], Separation::Nearer),
+            blob([110, 40, 135, 66], Separation::Farther),
+        ];
+        assert!(!touches_neighbour(0, &separated, width));
+        assert!(touches_neighbour(1, &separated, width));
+        let crowded = [
+            separated[0].clone(),
+            separated[1].clone(),
+            blob([141, 62, 160, 80], Separation::Whole),
+        ];
+        assert!(touches_neighbour(0, &crowded, width));
+        let strangers = [
+            separated[0].clone(),
+            Detection {
+                blob: 8,
+                ..separated[1].clone()
+            },
+        ];
+        assert!(
+            touches_neighbour(0, &strangers, width),
+            "a farther part of another blob"
+        );
+    }
+
+    #[test]
+    fn fusion_intersects_and_flags_conflicts() {
+        let a = RangeInterval::new(2.0, 6.0);
+        let b = RangeInterval::new(4.0, 9.0);
+        assert_eq!(
+            fuse([Some(a), Some(b), None]),
+            (RangeInterval::new(4.0, 6.0), false)
+        );
+        let c = RangeInterval::new(7.0, 8.0);
+        assert_eq!(
+            fuse([Some(a), None, Some(c)]),
+            (RangeInterval::new(2.0, 8.0), true)
+        );
+        assert_eq!(
+            fuse([None, None, None]),
+            (RangeInterval::unbounded(), false)
+        );
+    }
+
+    #[test]
+    fn azimuth_difference_wraps() {
+        assert!((azimuth_difference(0.1, TAU - 0.1) - 0.2).abs() < 1e-12);
+        assert!((azimuth_difference(TAU - 0.1, 0.1) + 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn column_overlap_across_the_seam() {
+        // [4090, 4100] wraps to columns 4090..4095 and 0..4; [0, 3] overlaps it.
+        assert!(columns_overlap([4090, 0, 4100, 10], [0, 0, 3, 10], 0, 4096));
+        assert!(!columns_overlap(
+            [4090, 0, 4100, 10],
+            [6, 0, 9, 10],
+            0,
+            4096
+        ));
+        assert!(!columns_overlap(
+            [100, 0, 110, 10],
+            [120, 0, 130, 10],
+            2,
+            4096
+        ));
+    }
+}

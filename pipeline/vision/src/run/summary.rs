@@ -1,0 +1,122 @@
+//! The few numbers a user wants at the end of `pipeline run` (also `summary.json`).
+
+use super::mapper::Mapper;
+use super::record::{Association, StationRecord};
+use qrm_core::calculus::Calculus;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    pub stations: usize,
+    /// Stations whose primary image could not be used.
+    pub stations_skipped: usize,
+    pub detections: usize,
+    pub landmarks: usize,
+    pub triples: usize,
+    pub open_fraction: f64,
+    pub fully_constrained_fraction: f64,
+    /// Panoramas the map rejected as contradicting it.
+    pub contradictions: usize,
+    /// Observations held back at their station, resolved later, and still pending at the end.
+    pub held_back: usize,
+    pub resolved_held_back: usize,
+    pub pending_held_back: usize,
+    /// Held back and given up (waited too long, or their station had too few fused partners).
+    pub expired_held_back: usize,
+    pub rng_certain: usize,
+    pub rng_uncertain: usize,
+    /// Seconds per stage, summed over stations (decode and detect run on all cores).
+    pub seconds_decode: f64,
+    pub seconds_detect: f64,
+    pub seconds_range: f64,
+    pub seconds_associate: f64,
+    pub seconds_map: f64,
+    /// Wall time of the parallel decode+detect stage and of the sequential mapping stage.
+    pub wall_front_end: f64,
+    pub wall_mapping: f64,
+}
+
+impl RunSummary {
+    pub fn of<C: Calculus>(
+        records: &[StationRecord],
+        mapper: &Mapper<C>,
+        skipped: usize,
+        wall_front_end: f64,
+        wall_mapping: f64,
+    ) -> RunSummary {
+        let last = records
+            .last()
+            .map(|r| r.metrics.clone())
+            .unwrap_or_default();
+        let sum = |f: fn(&StationRecord) -> f64| records.iter().map(f).sum::<f64>();
+        RunSummary {
+            stations: records.len(),
+            stations_skipped: skipped,
+            detections: records.iter().map(|r| r.detections.len()).sum(),
+            landmarks: last.landmarks,
+            triples: last.triples,
+            open_fraction: last.open_fraction,
+            fully_constrained_fraction: last.fully_constrained_fraction,
+            contradictions: records
+                .iter()
+                .filter(|r| r.fusion.contradiction.is_some())
+                .count(),
+            held_back: records
+                .iter()
+                .flat_map(|r| &r.detections)
+                .filter(|d| matches!(d.association, Association::HeldBack { .. }))
+                .count(),
+            resolved_held_back: records.iter().map(|r| r.fusion.resolved_held_back).sum(),
+            pending_held_back: mapper.held_back(),
+            expired_held_back: mapper.expired,
+            rng_certain: last.rng_certain,
+            rng_uncertain: last.rng_uncertain,
+            seconds_decode: sum(|r| r.seconds.decode),
+            seconds_detect: sum(|r| r.seconds.detect),
+            seconds_range: sum(|r| r.seconds.range),
+            seconds_associate: sum(|r| r.seconds.associate),
+            seconds_map: sum(|r| r.seconds.map),
+            wall_front_end,
+            wall_mapping,
+        }
+    }
+}
+
+impl fmt::Display for RunSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{} stations ({} skipped), {} detections → {} landmarks, {} triples",
+            self.stations, self.stations_skipped, self.detections, self.landmarks, self.triples
+        )?;
+        writeln!(
+            f,
+            "map: {:.1} % of states open, {:.1} % of triples fully constrained; RNG {} certain + {} uncertain edges",
+            100.0 * self.open_fraction,
+            100.0 * self.fully_constrained_fraction,
+            self.rng_certain,
+            self.rng_uncertain
+        )?;
+        writeln!(
+            f,
+            "contradictions: {}; held back: {} ({} resolved later, {} given up, {} pending)",
+            self.contradictions,
+            self.held_back,
+            self.resolved_held_back,
+            self.expired_held_back,
+            self.pending_held_back
+        )?;
+        write!(
+            f,
+            "time: decode {:.2} s + detect {:.2} s (CPU, {:.2} s wall) | range {:.2} s, associate {:.2} s, map {:.2} s ({:.2} s wall)",
+            self.seconds_decode,
+            self.seconds_detect,
+            self.wall_front_end,
+            self.seconds_range,
+            self.seconds_associate,
+            self.seconds_map,
+            self.wall_mapping
+        )
+    }
+}
