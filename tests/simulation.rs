@@ -5,8 +5,8 @@
 use qrm_core::calculus::Calculus;
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
-use qrm_core::map::Hypergraph;
-use qrm_core::simulation::{observations, run, MonteCarlo, Scenario, Sensor};
+use qrm_core::map::{Hypergraph, Sighting};
+use qrm_core::simulation::{run, MonteCarlo, Scenario, Sensor};
 use qrm_tests::rng;
 
 fn sound_runs<C: Calculus>(sensor: Sensor, seeds: std::ops::Range<u64>) {
@@ -68,7 +68,7 @@ fn batches(
         .iter()
         .map(|&station| {
             let (ids, panorama) = sensor.observe(&scenario.landmarks, station, &mut random);
-            observations(&empty, &ids, &panorama)
+            empty.observations(&panorama, &Sighting::all(&ids))
         })
         .collect()
 }

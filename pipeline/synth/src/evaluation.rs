@@ -6,11 +6,10 @@ use crate::dataset::{ImageTruth, Truth};
 use qrm_core::calculus::Calculus;
 use qrm_core::edc::Edc;
 use qrm_core::geometry::Point;
-use qrm_core::map::{Hypergraph, LandmarkId};
+use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
 use qrm_core::measurement::{Bearing, Panorama, RangeOrder};
 use qrm_core::metrics::evaluate;
 use qrm_core::neighborhood::{compare, estimate, RngComparison};
-use qrm_core::simulation::observations;
 use qrm_vision::calib::Calibration;
 use qrm_vision::run::{Association, LandmarkRecord, StationRecord};
 use serde::Serialize;
@@ -254,7 +253,7 @@ pub fn check_files(
     Ok(())
 }
 
-/// Everything `evaluate_run` needs, read by the caller.
+/// Everything `score_run` needs, read by the caller.
 pub struct RunFiles<'a> {
     pub records: &'a [StationRecord],
     pub landmarks: &'a [LandmarkRecord],
@@ -262,7 +261,7 @@ pub struct RunFiles<'a> {
 }
 
 /// Scores a run. `detectable` says which rocks count for recall.
-pub fn evaluate_run(
+pub fn score_run(
     run: &RunFiles,
     truth: &Truth,
     calib: &Calibration,
@@ -539,7 +538,7 @@ fn exact_map(
         else {
             continue;
         };
-        let batch = observations(&map, &ids, &panorama);
+        let batch = map.observations(&panorama, &Sighting::all(&ids));
         let _ = map.fuse(&batch);
     }
     map

@@ -36,7 +36,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| args.truth.with_file_name("calib.toml"));
     let calib = Calibration::load(&calib_path)?;
-    evaluate_run(&args.run, &args.truth, &calib, &out)
+    score_run_files(&args.run, &args.truth, &calib, &out)
 }
 
 fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
@@ -47,7 +47,7 @@ fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
 }
 
 /// Scores the run in `run_dir` against `truth_path`, writing `eval.json` into `out`.
-pub fn evaluate_run(
+pub fn score_run_files(
     run_dir: &Path,
     truth_path: &Path,
     calib: &Calibration,
@@ -69,7 +69,7 @@ pub fn evaluate_run(
         );
     }
     let settings = DetectorSettings::default();
-    let eval = evaluation::evaluate_run(
+    let eval = evaluation::score_run(
         &RunFiles {
             records: &records,
             landmarks: &landmarks,

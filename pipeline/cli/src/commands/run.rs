@@ -11,15 +11,13 @@ use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
 use qrm_core::neighborhood::estimate;
 use qrm_plot::{spring_layout, write_rng, RngPicture};
-use qrm_vision::association::AssociationSettings;
 use qrm_vision::calib::Calibration;
-use qrm_vision::detection::DetectorSettings;
-use qrm_vision::ranging::SensorModel;
-use qrm_vision::run::front_end::{detect_station, FrontEndResult};
-use qrm_vision::run::{Mapper, RunSummary, StationRecord};
+use qrm_vision::run::{
+    detect_survey, map_stations, Mapper, Progress, RunSettings, RunSummary, Stage, StationRecord,
+};
 use qrm_vision::survey::{read_image, Survey};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::Instant;
 
 #[derive(Args, Debug)]
@@ -78,32 +76,60 @@ fn rng_drawing(map: &Hypergraph<Edc>) -> RngDrawing {
     }
 }
 
-fn bar(len: usize, what: &str) -> ProgressBar {
-    let bar = ProgressBar::new(len as u64);
-    bar.set_style(
-        ProgressStyle::with_template(&format!(
-            "{{spinner}} {what:<9} [{{bar:40}}] {{pos}}/{{len}} ({{elapsed}}, eta {{eta}})"
-        ))
-        .expect("static template")
-        .progress_chars("=> "),
-    );
-    bar
+/// Progress bars on the terminal, one per stage; warnings printed above them.
+#[derive(Default)]
+struct Bars {
+    current: Mutex<Option<ProgressBar>>,
+}
+
+impl Bars {
+    fn with_bar(&self, f: impl FnOnce(&ProgressBar)) {
+        if let Some(bar) = self.current.lock().expect("no panics hold it").as_ref() {
+            f(bar);
+        }
+    }
+}
+
+impl Progress for Bars {
+    fn begin(&self, stage: Stage, stations: usize) {
+        let what = match stage {
+            Stage::Detect => "detect",
+            Stage::Map => "map",
+        };
+        let bar = ProgressBar::new(stations as u64);
+        bar.set_style(
+            ProgressStyle::with_template(&format!(
+                "{{spinner}} {what:<9} [{{bar:40}}] {{pos}}/{{len}} ({{elapsed}}, eta {{eta}})"
+            ))
+            .expect("static template")
+            .progress_chars("=> "),
+        );
+        *self.current.lock().expect("no panics hold it") = Some(bar);
+    }
+
+    fn advance(&self) {
+        self.with_bar(|bar| bar.inc(1));
+    }
+
+    fn end(&self) {
+        if let Some(bar) = self.current.lock().expect("no panics hold it").take() {
+            bar.finish_and_clear();
+        }
+    }
+
+    fn warn(&self, message: &str) {
+        let print = || eprintln!("warning: {message}");
+        match self.current.lock().expect("no panics hold it").as_ref() {
+            Some(bar) => bar.suspend(print),
+            None => print(),
+        }
+    }
 }
 
 pub fn run(args: RunArgs) -> Result<()> {
     let started = Instant::now();
     let survey = Survey::open(&args.images)?;
-    let calib_path = args
-        .calib
-        .clone()
-        .unwrap_or_else(|| args.images.join("calib.toml"));
-    if !calib_path.exists() {
-        bail!(
-            "no calibration: {} does not exist (give one with --calib FILE; format in calib/README.md)",
-            calib_path.display()
-        );
-    }
-    let calib = Calibration::load(&calib_path)?;
+    let calib = load_calibration(&args)?;
     for path in &survey.unpaired {
         eprintln!(
             "warning: {} has no _left partner and is not used",
@@ -115,117 +141,100 @@ pub fn run(args: RunArgs) -> Result<()> {
         bail!("--rrd needs a build with the rerun feature: cargo build --release -p pipeline --features rerun");
     }
 
-    let detector = DetectorSettings::default();
-    let progress = bar(survey.stations.len(), "detect");
-    let front: Vec<FrontEndResult> = survey
-        .stations
-        .par_iter()
-        .map(|station| {
-            let result = detect_station(station, &survey.directory, &calib, &detector);
-            progress.inc(1);
-            result
-        })
-        .collect();
-    progress.finish_and_clear();
-    let detect_wall = started.elapsed().as_secs_f64();
-
-    if front.iter().all(|r| r.station.is_err()) {
-        for result in &front {
-            if let Err(warning) = &result.station {
-                eprintln!("warning: {warning}");
-            }
-        }
-        bail!(
-            "none of the {} stations in {} could be read; nothing was written",
-            survey.stations.len(),
-            survey.directory.display()
-        );
-    }
+    let settings = RunSettings::default();
+    let bars = Bars::default();
+    let detected = match detect_survey(&survey, &calib, &settings.detector, &bars) {
+        Ok(detected) => detected,
+        Err(e) => bail!("{e}; nothing was written"),
+    };
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
     let mut recorders = recorders(&args)?;
-    let wants_panorama = recorders.iter().any(|r| r.wants_panorama());
-    let no_image = RgbImage::new(0, 0);
-    let mut mapper: Mapper<Edc> = Mapper::new(
-        calib,
-        SensorModel::default(),
-        AssociationSettings::default(),
-    );
-    let mut records: Vec<StationRecord> = Vec::new();
-    let mut skipped = Vec::new();
-    let progress = bar(front.len(), "map");
-    let map_started = Instant::now();
-    for result in &front {
-        progress.inc(1);
-        let station = match &result.station {
-            Ok(station) => station,
-            Err(warning) => {
-                progress.suspend(|| eprintln!("warning: {warning}"));
-                skipped.push(warning.clone());
-                continue;
-            }
-        };
-        let mut record = mapper.process(records.len(), station);
-        record.seconds.decode = result.decode_seconds;
-        record.seconds.detect = result.detect_seconds;
-        for warning in &record.warnings {
-            progress.suspend(|| eprintln!("warning: {warning}"));
-        }
-        let panorama = if wants_panorama {
-            let primary = survey.directory.join(&station.files[0]);
-            read_image(&primary, (calib.image.width, calib.image.height))?
-        } else {
-            no_image.clone()
-        };
-        let drawing = rng_drawing(&mapper.map);
-        for recorder in &mut recorders {
-            let image = if recorder.wants_panorama() {
-                &panorama
-            } else {
-                &no_image
-            };
-            recorder.station(&record, image)?;
-            recorder.rng(record.index, &drawing)?;
-        }
-        records.push(record);
-    }
-    progress.finish_and_clear();
-    let map_wall = map_started.elapsed().as_secs_f64();
+    let mapper: Mapper<Edc> = Mapper::new(calib.clone(), settings.sensor, settings.association);
+    let traverse = map_stations(&detected, mapper, &bars, |record, mapper| {
+        record_station(&mut recorders, record, &mapper.map, &survey, &calib)
+    })?;
 
-    write_outputs(&args.out, &mapper, &records)?;
+    write_outputs(&args.out, &traverse.mapper, &traverse.records)?;
     for recorder in recorders {
         recorder.finish()?;
     }
-    let summary = RunSummary::of(&records, &mapper, skipped.len(), detect_wall, map_wall);
+    let summary = traverse.summary(detected.wall_seconds);
     write_atomic(
         &args.out.join("summary.json"),
         (serde_json::to_string_pretty(&summary)? + "\n").as_bytes(),
     )?;
-    println!("{summary}");
-    println!(
-        "total {:.2} s; outputs in {}",
-        started.elapsed().as_secs_f64(),
-        args.out.display()
-    );
-    if args.out.join("rng.png").exists() {
-        println!("  look at {} (the RNG)", args.out.join("rng.png").display());
-    }
-    println!(
-        "  the map is {} (docs/MAP_FORMAT.md); everything per station is in {} (docs/RUN_OUTPUTS.md)",
-        args.out.join("map.json").display(),
-        args.out.join("run.mcap").display()
-    );
-
+    print_summary(&summary, &args.out, started);
     let truth = args.truth.clone().or_else(|| {
         let default = args.images.join("truth.json");
         default.exists().then_some(default)
     });
     match (truth, args.no_eval) {
-        (Some(truth), false) => super::eval::evaluate_run(&args.out, &truth, &calib, &args.out)?,
+        (Some(truth), false) => super::eval::score_run_files(&args.out, &truth, &calib, &args.out)?,
         // A scoring left from an earlier run into the same directory would not be this run's.
         _ => remove_stale(&args.out.join("eval.json"))?,
     }
     Ok(())
+}
+
+/// `--calib`, or calib.toml in the image directory.
+fn load_calibration(args: &RunArgs) -> Result<Calibration> {
+    let path = args
+        .calib
+        .clone()
+        .unwrap_or_else(|| args.images.join("calib.toml"));
+    if !path.exists() {
+        bail!(
+            "no calibration: {} does not exist (give one with --calib FILE; format in calib/README.md)",
+            path.display()
+        );
+    }
+    Ok(Calibration::load(&path)?)
+}
+
+/// Hands one mapped station to every recorder, with its panorama for those that show it.
+fn record_station(
+    recorders: &mut [Box<dyn Recorder>],
+    record: &StationRecord,
+    map: &Hypergraph<Edc>,
+    survey: &Survey,
+    calib: &Calibration,
+) -> Result<()> {
+    let no_image = RgbImage::new(0, 0);
+    let panorama = if recorders.iter().any(|r| r.wants_panorama()) {
+        let primary = survey.directory.join(&record.files[0]);
+        read_image(&primary, (calib.image.width, calib.image.height))?
+    } else {
+        no_image.clone()
+    };
+    let drawing = rng_drawing(map);
+    for recorder in recorders.iter_mut() {
+        let image = if recorder.wants_panorama() {
+            &panorama
+        } else {
+            &no_image
+        };
+        recorder.station(record, image)?;
+        recorder.rng(record.index, &drawing)?;
+    }
+    Ok(())
+}
+
+fn print_summary(summary: &RunSummary, out: &Path, started: Instant) {
+    println!("{summary}");
+    println!(
+        "total {:.2} s; outputs in {}",
+        started.elapsed().as_secs_f64(),
+        out.display()
+    );
+    if out.join("rng.png").exists() {
+        println!("  look at {} (the RNG)", out.join("rng.png").display());
+    }
+    println!(
+        "  the map is {} (docs/MAP_FORMAT.md); everything per station is in {} (docs/RUN_OUTPUTS.md)",
+        out.join("map.json").display(),
+        out.join("run.mcap").display()
+    );
 }
 
 /// Removes an output of an earlier run into the same directory that this run does not write.

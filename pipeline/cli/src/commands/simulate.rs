@@ -9,11 +9,11 @@ use qrm_core::calculus::Calculus;
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
 use qrm_core::geometry::Point;
-use qrm_core::map::Hypergraph;
+use qrm_core::map::{Hypergraph, Sighting};
 use qrm_core::measurement::MAX_BEARING_UNCERTAINTY;
 use qrm_core::neighborhood::{estimate, true_rng};
 use qrm_core::simulation::{
-    observations, run, MonteCarlo, MonteCarloResult, Scenario, Sensor, Series, Statistic,
+    run, MonteCarlo, MonteCarloResult, Scenario, Sensor, Series, Statistic,
 };
 use qrm_plot::{write_panels, write_rng, Curve, Panel, RngPicture};
 use rand::SeedableRng;
@@ -459,7 +459,7 @@ fn basic<C: Calculus>(seed: u64) -> Result<()> {
             .map(|&station| {
                 let (ids, panorama) = sensor.observe(&scenario.landmarks, station, &mut rng);
                 let mut trial = map.clone();
-                let _ = trial.fuse(&observations(&trial, &ids, &panorama));
+                let _ = trial.fuse(&trial.observations(&panorama, &Sighting::all(&ids)));
                 (trial.open_states(), station, trial)
             })
             .min_by_key(|(open, _, _)| *open)

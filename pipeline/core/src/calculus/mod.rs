@@ -48,13 +48,4 @@ pub trait Calculus: Send + Sync + 'static {
     fn adjacent(_r: u8) -> Option<RelationSet> {
         None
     }
-
-    /// The EDC regions a measurement must test when `open` relations are still possible.
-    fn edc_candidates(open: RelationSet) -> RelationSet {
-        RelationSet::from_relations((1..=crate::edc::REGIONS).filter(|&r| {
-            !Self::from_edc(RelationSet::single(r))
-                .intersection(open)
-                .is_empty()
-        }))
-    }
 }

@@ -4,6 +4,8 @@
 //! - [`Hypergraph`] storage and queries (000 §VI-A);
 //! - [`Hypergraph::fuse`]: one panorama's measurements, intersected in and propagated
 //!   (000 §VI-B), as one transaction;
+//! - [`Hypergraph::observations`]: the measured triples of a panorama's [`Sighting`]s as
+//!   observations, measured against what the map still allows (000 §IV, §VI-B);
 //! - [`Hypergraph::merge`]: fusing another map over the same landmark ids;
 //! - JSON files (`docs/MAP_FORMAT.md`).
 
@@ -12,12 +14,14 @@ mod hypergraph;
 mod index;
 mod json;
 mod kernel;
+mod observe;
 mod quad;
 mod transaction;
 mod update;
 
 pub use hypergraph::{Hypergraph, Triples};
 pub use json::{MapFormatError, MAX_LANDMARKS};
+pub use observe::Sighting;
 pub use update::{Contradiction, ContradictionStage, LandmarkId, Observation, UpdateReport};
 
 use crate::calculus::Calculus;

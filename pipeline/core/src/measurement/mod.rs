@@ -17,6 +17,7 @@ pub use sweep::sweep_regions;
 pub use triple::{by_search, by_sweep, measure_triple_edc, TripleRelations};
 
 use crate::calculus::{Calculus, RelationSet};
+use crate::edc::REGIONS;
 use rayon::prelude::*;
 use std::f64::consts::FRAC_PI_4;
 use thiserror::Error;
@@ -120,7 +121,7 @@ impl Panorama {
     ) -> TripleRelations {
         let bearings = landmarks.map(|i| self.bearings[i]);
         let nearer = self.order.restricted(&landmarks);
-        match measure_triple_edc(bearings, &nearer, open.map(C::edc_candidates)) {
+        match measure_triple_edc(bearings, &nearer, open.map(edc_candidates::<C>)) {
             Some(regions) => std::array::from_fn(|k| C::from_edc(regions[k]).intersection(open[k])),
             None => open,
         }
@@ -154,4 +155,16 @@ pub struct TripleMeasurement {
     pub landmarks: [usize; 3],
     /// `[AB:C, BC:A, CA:B]`.
     pub states: [RelationSet; 3],
+}
+
+/// The EDC regions a measurement must test when the relations `open` of calculus `C` are still
+/// possible: those from which some open relation can follow (000 §IV measures EDC regions, the
+/// finest cells of both calculi). Here rather than on `Calculus` so that the calculus layer
+/// does not depend on the EDC calculus built on it.
+fn edc_candidates<C: Calculus>(open: RelationSet) -> RelationSet {
+    RelationSet::from_relations((1..=REGIONS).filter(|&r| {
+        !C::from_edc(RelationSet::single(r))
+            .intersection(open)
+            .is_empty()
+    }))
 }

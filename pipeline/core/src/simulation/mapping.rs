@@ -3,8 +3,8 @@
 
 use super::scenario::Scenario;
 use super::sensor::Sensor;
-use crate::calculus::{Calculus, RelationSet};
-use crate::map::{Hypergraph, LandmarkId, Observation};
+use crate::calculus::Calculus;
+use crate::map::{Hypergraph, LandmarkId, Sighting};
 use crate::metrics::{evaluate, MapMetrics};
 use crate::neighborhood::{compare, estimate, RngComparison};
 use rand::SeedableRng;
@@ -24,34 +24,6 @@ pub struct Step {
     pub visible: usize,
     /// Whether the panorama contradicted the map and was rejected.
     pub contradiction: bool,
-}
-
-/// The measurements of one panorama as map observations, restricted to what `map` allows.
-pub fn observations<C: Calculus>(
-    map: &Hypergraph<C>,
-    ids: &[LandmarkId],
-    panorama: &crate::measurement::Panorama,
-) -> Vec<Observation> {
-    let open = |[a, b, c]: [usize; 3]| -> [RelationSet; 3] {
-        let (a, b, c) = (ids[a], ids[b], ids[c]);
-        [
-            map.relation(a, b, c).unwrap_or(C::universe()),
-            map.relation(b, c, a).unwrap_or(C::universe()),
-            map.relation(c, a, b).unwrap_or(C::universe()),
-        ]
-    };
-    panorama
-        .measure_all::<C, _>(open)
-        .into_iter()
-        .flat_map(|m| {
-            let [a, b, c] = m.landmarks.map(|i| ids[i]);
-            [
-                Observation::new(a, b, c, m.states[0]),
-                Observation::new(b, c, a, m.states[1]),
-                Observation::new(c, a, b, m.states[2]),
-            ]
-        })
-        .collect()
 }
 
 /// Maps `scenario` with `sensor`, scoring after every station; returns the scores and the
@@ -79,7 +51,7 @@ pub fn run<C: Calculus>(
     for &station in &scenario.stations {
         let (ids, panorama) = sensor.observe(points, station, &mut rng);
         let start = Instant::now();
-        let batch = observations(&map, &ids, &panorama);
+        let batch = map.observations(&panorama, &Sighting::all(&ids));
         let contradiction = map.fuse(&batch).is_err();
         let seconds = start.elapsed().as_secs_f64();
         let rng_estimate = estimate(&map);

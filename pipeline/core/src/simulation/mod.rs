@@ -7,7 +7,7 @@ mod montecarlo;
 mod scenario;
 mod sensor;
 
-pub use mapping::{observations, run, Step};
+pub use mapping::{run, Step};
 pub use montecarlo::{MonteCarlo, MonteCarloResult, Series, Statistic};
 pub use scenario::Scenario;
 pub use sensor::Sensor;

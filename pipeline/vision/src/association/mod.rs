@@ -34,7 +34,7 @@ pub use registration::{register, Frame, Placed, Registration};
 use crate::detection::Appearance;
 use crate::ranging::RangeInterval;
 use qrm_core::calculus::Calculus;
-use qrm_core::map::{Hypergraph, LandmarkId};
+use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
 use qrm_core::measurement::Panorama;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -82,6 +82,16 @@ pub struct Evidence {
     pub appearance: Appearance,
     /// Physical width bounds from this station's range evidence.
     pub width: Option<RangeInterval>,
+    /// Rough position around the station, if its range is bounded well enough.
+    pub placed: Option<Placed>,
+}
+
+/// One station as association sees it: the bearings and range order of its usable detections,
+/// and the evidence of the detection at each position of the panorama.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StationEvidence {
+    pub panorama: Panorama,
+    pub detections: Vec<Evidence>,
 }
 
 /// The association decision for one detection.
@@ -92,18 +102,17 @@ pub enum Decision {
     HeldBack(Vec<LandmarkId>),
 }
 
-/// Associates the detections of one station (`panorama` holds their bearings and range order,
-/// `evidence` their looks and `placed` their rough positions around the station, all indexed
-/// alike; `frames` are recent stations' landmarks placed the same way).
+/// Associates the detections of one station with the landmarks of `map` and `gallery`;
+/// `frames` are recent stations' landmarks placed around them.
 pub fn associate<C: Calculus>(
     map: &Hypergraph<C>,
     gallery: &Gallery,
-    panorama: &Panorama,
-    evidence: &[Evidence],
-    placed: &[Option<Placed>],
     frames: &[Frame],
+    station: &StationEvidence,
     settings: &AssociationSettings,
 ) -> Vec<Decision> {
+    let (panorama, evidence) = (&station.panorama, &station.detections);
+    let placed: Vec<Option<Placed>> = evidence.iter().map(|e| e.placed).collect();
     let n = evidence.len();
     if gallery.is_empty() {
         return vec![Decision::New; n];
@@ -124,7 +133,7 @@ pub fn associate<C: Calculus>(
     let recent = |l: LandmarkId| frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
     let registrations: Vec<(&Frame, Registration)> = frames
         .iter()
-        .filter_map(|frame| Some((frame, register(placed, frame, &alike, &seed)?)))
+        .filter_map(|frame| Some((frame, register(&placed, frame, &alike, &seed)?)))
         .collect();
     // A station's only registration is a chance fit of look-alikes when several other frames
     // hold enough of its landmarks to have found the same pairing and none did.
@@ -193,12 +202,12 @@ pub fn associate<C: Calculus>(
         })
         .collect();
     drop_inconsistent_anchors(map, panorama, &mut anchors);
-    let anchored: Vec<(usize, LandmarkId)> = anchors.iter().map(|a| (a.0, a.1)).collect();
+    let anchored: Vec<Sighting> = anchors.iter().map(|a| Sighting::new(a.0, a.1)).collect();
 
     (0..n)
         .into_par_iter()
-        .map(|i| match anchored.iter().find(|a| a.0 == i) {
-            Some(&(_, landmark)) => Decision::Matched(landmark),
+        .map(|i| match anchored.iter().find(|a| a.position == i) {
+            Some(anchor) => Decision::Matched(anchor.landmark),
             None => {
                 let survivors = survivors(
                     map,
@@ -222,7 +231,7 @@ pub fn associate<C: Calculus>(
 /// Re-tests one held-back detection of an earlier station against the current map (000 §VI-C
 /// "delayed until the map has converged further"): the candidates the map still allows, empty
 /// when it rejects them all (a new landmark). `decided` are the other detections of that
-/// station with their landmarks; `None` when they took every candidate, which says nothing
+/// station's sightings; `None` when they took every candidate, which says nothing
 /// about which rock this one is (a new landmark would duplicate a rock never proposed).
 ///
 /// A candidate left alone after the others were rejected is not matched: it is no surer than
@@ -232,12 +241,12 @@ pub fn reconsider<C: Calculus>(
     panorama: &Panorama,
     detection: usize,
     candidates: &[LandmarkId],
-    decided: &[(usize, LandmarkId)],
+    decided: &[Sighting],
     settings: &AssociationSettings,
 ) -> Option<Vec<LandmarkId>> {
     let open: Vec<(LandmarkId, f64)> = candidates
         .iter()
-        .filter(|l| !decided.iter().any(|d| d.1 == **l))
+        .filter(|l| !decided.iter().any(|d| d.landmark == **l))
         .map(|&l| (l, settings.gate))
         .collect();
     if open.is_empty() {
@@ -345,11 +354,11 @@ fn survivors<C: Calculus>(
     panorama: &Panorama,
     detection: usize,
     candidates: &[(LandmarkId, f64)],
-    anchors: &[(usize, LandmarkId)],
+    anchors: &[Sighting],
     recent: &(dyn Fn(LandmarkId) -> bool + Sync),
     settings: &AssociationSettings,
 ) -> Vec<LandmarkId> {
-    let taken = |l: LandmarkId| anchors.iter().any(|a| a.1 == l);
+    let taken = |l: LandmarkId| anchors.iter().any(|a| a.landmark == l);
     candidates
         .iter()
         .filter(|c| !taken(c.0))
@@ -371,7 +380,7 @@ fn test_candidate<C: Calculus>(
     panorama: &Panorama,
     detection: usize,
     landmark: LandmarkId,
-    anchors: &[(usize, LandmarkId)],
+    anchors: &[Sighting],
     settings: &AssociationSettings,
 ) -> Option<usize> {
     // The pairs on which the map knows most about the candidate first.
@@ -379,13 +388,13 @@ fn test_candidate<C: Calculus>(
     for x in 0..anchors.len() {
         for y in x + 1..anchors.len() {
             let (p, q) = (anchors[x], anchors[y]);
-            if let Some(r) = map.relation(landmark, p.1, q.1) {
+            if let Some(r) = map.relation(landmark, p.landmark, q.landmark) {
                 let open = r.len() as u32
                     + map
-                        .relation(p.1, q.1, landmark)
+                        .relation(p.landmark, q.landmark, landmark)
                         .map_or(0, |s| s.len() as u32)
                     + map
-                        .relation(q.1, landmark, p.1)
+                        .relation(q.landmark, landmark, p.landmark)
                         .map_or(0, |s| s.len() as u32);
                 if open < 3 * C::universe().len() as u32 {
                     pairs.push((x, y, open));
@@ -397,7 +406,12 @@ fn test_candidate<C: Calculus>(
     let mut informative = 0;
     for &(x, y, _) in pairs.iter().take(settings.tested_pairs) {
         let (p, q) = (anchors[x], anchors[y]);
-        match triple_consistency(map, panorama, [detection, p.0, q.0], [landmark, p.1, q.1]) {
+        match triple_consistency(
+            map,
+            panorama,
+            [detection, p.position, q.position],
+            [landmark, p.landmark, q.landmark],
+        ) {
             Some(false) => return None,
             Some(true) => informative += 1,
             None => {}
@@ -428,7 +442,7 @@ mod tests {
 
     /// The station's detections at `points` (bearings from the positions, no range order),
     /// all alike, with landmarks 0‥6 in the gallery.
-    fn station(points: &[[f64; 2]]) -> (Gallery, Panorama, Vec<Evidence>, Vec<Option<Placed>>) {
+    fn station(points: &[[f64; 2]]) -> (Gallery, StationEvidence) {
         let mut gallery = Gallery::default();
         for l in 0..=6 {
             gallery.observe(l, look(), None);
@@ -441,34 +455,33 @@ mod tests {
             })
             .collect();
         let panorama = Panorama::new(bearings, RangeOrder::unordered(points.len())).unwrap();
-        let evidence = points
+        let detections = points
             .iter()
-            .map(|_| Evidence {
+            .map(|&p| Evidence {
                 appearance: look(),
                 width: None,
+                placed: Some(at(p)),
             })
             .collect();
-        let placed = points.iter().map(|&p| Some(at(p))).collect();
-        (gallery, panorama, evidence, placed)
+        (
+            gallery,
+            StationEvidence {
+                panorama,
+                detections,
+            },
+        )
     }
 
     /// Associates the station against `frames` on an empty map with default settings.
     fn associate_station(
-        (gallery, panorama, evidence, placed): &(
-            Gallery,
-            Panorama,
-            Vec<Evidence>,
-            Vec<Option<Placed>>,
-        ),
+        (gallery, station): &(Gallery, StationEvidence),
         frames: &[Frame],
     ) -> Vec<Decision> {
         associate(
             &Hypergraph::<Edc>::new(),
             gallery,
-            panorama,
-            evidence,
-            placed,
             frames,
+            station,
             &AssociationSettings::default(),
         )
     }
@@ -491,7 +504,7 @@ mod tests {
         let mut points = FIELD.to_vec();
         points.extend([[-1.0, 9.0], [-1.5, 9.0]]);
         let mut station = station(&points);
-        station.2[7].appearance = Appearance {
+        station.1.detections[7].appearance = Appearance {
             colour: [0.2, 0.3, 0.5],
             brightness: 3.0,
             texture: 0.6,

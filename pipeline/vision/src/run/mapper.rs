@@ -3,18 +3,17 @@
 //! observations are retried after every station.
 
 use super::record::{Association, DetectionRecord, MetricsRecord, RangeRecord, StationRecord};
+use super::selection;
 use crate::association::{
-    associate, reconsider, AssociationSettings, Decision, Evidence, Frame, Gallery, Placed,
+    associate, reconsider, AssociationSettings, Decision, Evidence, Frame, Gallery,
 };
 use crate::calib::Calibration;
 use crate::detection::{Detection, Separation};
-use crate::ranging::{self, PrimaryEye, RangeInterval, Ranged, SensorModel};
-use qrm_core::calculus::{Calculus, RelationSet};
-use qrm_core::map::{Hypergraph, LandmarkId, Observation};
-use qrm_core::measurement::{Bearing, Panorama, MAX_BEARING_UNCERTAINTY};
+use crate::ranging::{self, PrimaryEye, Ranged, SensorModel};
+use qrm_core::calculus::Calculus;
+use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
+use qrm_core::measurement::Panorama;
 use qrm_core::neighborhood::estimate;
-use qrm_core::simulation::observations;
-use rayon::prelude::*;
 use std::time::Instant;
 
 /// One station's detections, ready for mapping.
@@ -48,7 +47,7 @@ struct HeldBack {
     primary_index: usize,
     candidates: Vec<LandmarkId>,
     /// The station's other detections that were fused, with their landmarks.
-    decided: Vec<(usize, LandmarkId)>,
+    decided: Vec<Sighting>,
     evidence: Evidence,
 }
 
@@ -126,21 +125,7 @@ impl<C: Calculus> Mapper<C> {
             &self.sensor,
         );
         record.seconds.range = start.elapsed().as_secs_f64();
-        // Detections the detector doubts (possibly several rocks, or part of one), pieces
-        // touching another piece, stacks, and those whose bearing is too uncertain to measure
-        // with are not used.
-        let width = self.calib.image.width;
-        let narrowest = MIN_COLUMNS.max(width / 512);
-        let usable: Vec<usize> = (0..ranged.len())
-            .filter(|&i| {
-                let d = &station.primary[i];
-                !d.ambiguous
-                    && d.bbox[2] + 1 >= d.bbox[0] + narrowest
-                    && !stacked(d)
-                    && !ranging::touches_neighbour(i, &station.primary, width)
-                    && ranged[i].bearing.uncertainty < MAX_BEARING_UNCERTAINTY
-            })
-            .collect();
+        let usable = selection::usable(station, &ranged, self.calib.image.width);
         record.detections = station
             .primary
             .iter()
@@ -159,132 +144,144 @@ impl<C: Calculus> Mapper<C> {
         }
 
         let start = Instant::now();
-        let panorama = panorama_of(&ranged, &usable);
-        let evidence: Vec<Evidence> = usable
-            .iter()
-            .map(|&i| Evidence {
-                appearance: station.primary[i].appearance.clone(),
-                width: width_of(&station.primary[i], &ranged[i], &self.sensor),
-            })
-            .collect();
-        let placed: Vec<Option<Placed>> = usable.iter().map(|&i| placed(&ranged[i])).collect();
+        let evidence = selection::station_evidence(station, &ranged, &usable, &self.sensor);
         let decisions = associate(
             &self.map,
             &self.gallery,
-            &panorama,
-            &evidence,
-            &placed,
             &self.frames,
+            &evidence,
             &self.association,
         );
         record.seconds.associate = start.elapsed().as_secs_f64();
 
         let start = Instant::now();
-        // Landmark ids of the detections to fuse (positions in `usable`).
-        let mut fused: Vec<(usize, LandmarkId)> = Vec::new();
-        let mut fresh = self.next_landmark;
-        let mut held = Vec::new();
-        for (k, decision) in decisions.iter().enumerate() {
-            match decision {
-                Decision::Matched(l) => fused.push((k, *l)),
-                Decision::New => {
-                    fused.push((k, fresh));
-                    fresh += 1;
-                }
-                Decision::HeldBack(candidates) => held.push((k, candidates.clone())),
-            }
-        }
-        // The size cue, for landmarks whose width earlier stations bounded (not for parts of
-        // a blob separated by parallax: see `width_of`).
-        for &(k, l) in &fused {
-            if station.primary[usable[k]].separation != Separation::Whole {
-                continue;
-            }
-            if let Some(width) = self.gallery.profile(l).and_then(|p| p.width) {
-                ranging::apply_size(&mut ranged[usable[k]], width, &self.sensor);
-            }
-        }
+        let associated =
+            Associated::new(usable, evidence.detections, decisions, self.next_landmark);
+        self.apply_size_cue(station, &mut ranged, &associated);
         for (i, r) in ranged.iter().enumerate() {
             record.detections[i].range = detection_record(&station.primary[i], r).range;
         }
-        let panorama = panorama_of(&ranged, &usable);
-        record.order = (0..usable.len())
-            .flat_map(|a| (0..usable.len()).map(move |b| (a, b)))
-            .filter(|&(a, b)| panorama.order.is_nearer(a, b))
-            .map(|(a, b)| (usable[a], usable[b]))
-            .collect();
-        let fused_positions: Vec<usize> = fused.iter().map(|f| f.0).collect();
-        let ids: Vec<LandmarkId> = fused.iter().map(|f| f.1).collect();
+        let panorama = selection::panorama_of(&ranged, &associated.usable);
+        record.order = asserted_order(&panorama, &associated.usable);
+        self.fuse_station(&mut record, associated, panorama);
+        record.fusion.resolved_held_back = self.retry_held_back(&mut record);
+        record.seconds.map = start.elapsed().as_secs_f64();
+        record.metrics = self.metrics();
+        record
+    }
+
+    /// The size cue, for landmarks whose width earlier stations bounded (not for parts of a
+    /// blob separated by parallax: see `selection::width_of`).
+    fn apply_size_cue(
+        &self,
+        station: &StationDetections,
+        ranged: &mut [Ranged],
+        associated: &Associated,
+    ) {
+        for s in &associated.fused {
+            let i = associated.usable[s.position];
+            if station.primary[i].separation != Separation::Whole {
+                continue;
+            }
+            if let Some(width) = self.gallery.profile(s.landmark).and_then(|p| p.width) {
+                ranging::apply_size(&mut ranged[i], width, &self.sensor);
+            }
+        }
+    }
+
+    /// Fuses the station's associated detections (000 §VI-B) and, if the map takes them,
+    /// remembers their looks, sightings and placement, and holds back the undecided ones.
+    fn fuse_station(
+        &mut self,
+        record: &mut StationRecord,
+        associated: Associated,
+        panorama: Panorama,
+    ) {
         // With fewer than three landmarks there is no triple to measure, but the sightings
         // still place and describe the landmarks for association at later stations.
-        let sub = sub_panorama(&panorama, &fused_positions);
-        let batch = if ids.len() >= 3 {
-            observations(&self.map, &ids, &sub)
+        let batch = if associated.fused.len() >= 3 {
+            self.map.observations(&panorama, &associated.fused)
         } else {
             Vec::new()
         };
-        record.fusion.landmarks = ids.len();
+        record.fusion.landmarks = associated.fused.len();
         record.fusion.triples = batch.len() / 3;
         match self.map.fuse(&batch) {
             Ok(report) => {
                 record.fusion.relations_tightened = report.relations_tightened;
-                self.next_landmark = fresh;
-                for &(position, landmark) in &fused {
-                    let i = usable[position];
-                    // The size cue applied since does not enter the width evidence.
-                    self.gallery.observe(
-                        landmark,
-                        evidence[position].appearance.clone(),
-                        evidence[position].width,
-                    );
-                    self.sightings.push((index, i, landmark));
-                    record.detections[i].association = match decisions[position] {
-                        Decision::New => Association::New { landmark },
-                        _ => Association::Matched { landmark },
-                    };
-                }
-                let frame = Frame {
-                    landmarks: fused
-                        .iter()
-                        .filter_map(|&(position, landmark)| Some((landmark, placed[position]?)))
-                        .collect(),
-                };
-                // A station that fused too few landmarks to register against does not push an
-                // older, useful one out: with no registrable frame left, every rock would come
-                // back as a new landmark.
-                if frame.registrable() {
-                    self.frames.push(frame);
-                    if self.frames.len() > RECENT_FRAMES {
-                        self.frames.remove(0);
-                    }
-                }
-                for (k, candidates) in held {
-                    record.detections[usable[k]].association = Association::HeldBack {
-                        candidates: candidates.clone(),
-                    };
-                    self.held.push(HeldBack {
-                        station: index,
-                        panorama: panorama.clone(),
-                        detection: k,
-                        primary_index: usable[k],
-                        candidates,
-                        decided: fused.clone(),
-                        evidence: evidence[k].clone(),
-                    });
-                }
+                self.next_landmark = associated.next_landmark;
+                self.remember(record, &associated);
+                self.hold_back(record, associated, panorama);
             }
             Err(contradiction) => {
                 record.fusion.contradiction = Some(contradiction.to_string());
                 record.warnings.push(format!(
                     "{}: the panorama contradicts the map and was not fused ({contradiction})",
-                    station.name
+                    record.station
                 ));
             }
         }
-        record.fusion.resolved_held_back = self.retry_held_back(&mut record);
-        record.seconds.map = start.elapsed().as_secs_f64();
-        record.metrics = self.metrics();
-        record
+    }
+
+    /// Records the fused detections' looks and sightings, and the station's frame for
+    /// registration at later stations.
+    fn remember(&mut self, record: &mut StationRecord, associated: &Associated) {
+        for s in &associated.fused {
+            let i = associated.usable[s.position];
+            let evidence = &associated.evidence[s.position];
+            // The size cue applied since does not enter the width evidence.
+            self.gallery
+                .observe(s.landmark, evidence.appearance.clone(), evidence.width);
+            self.sightings.push((record.index, i, s.landmark));
+            record.detections[i].association = match associated.decisions[s.position] {
+                Decision::New => Association::New {
+                    landmark: s.landmark,
+                },
+                _ => Association::Matched {
+                    landmark: s.landmark,
+                },
+            };
+        }
+        let frame = Frame {
+            landmarks: associated
+                .fused
+                .iter()
+                .filter_map(|s| Some((s.landmark, associated.evidence[s.position].placed?)))
+                .collect(),
+        };
+        // A station that fused too few landmarks to register against does not push an older,
+        // useful one out: with no registrable frame left, every rock would come back as a new
+        // landmark.
+        if frame.registrable() {
+            self.frames.push(frame);
+            if self.frames.len() > RECENT_FRAMES {
+                self.frames.remove(0);
+            }
+        }
+    }
+
+    /// Keeps the station's undecided detections to be tried again on a tighter map.
+    fn hold_back(
+        &mut self,
+        record: &mut StationRecord,
+        associated: Associated,
+        panorama: Panorama,
+    ) {
+        for (position, candidates) in associated.held {
+            let primary_index = associated.usable[position];
+            record.detections[primary_index].association = Association::HeldBack {
+                candidates: candidates.clone(),
+            };
+            self.held.push(HeldBack {
+                station: record.index,
+                panorama: panorama.clone(),
+                detection: position,
+                primary_index,
+                candidates,
+                decided: associated.fused.clone(),
+                evidence: associated.evidence[position].clone(),
+            });
+        }
     }
 
     /// Tries every held-back observation against the current map; returns how many were
@@ -324,7 +321,11 @@ impl<C: Calculus> Mapper<C> {
                 Some(_) => done[k] = true,
             }
             let landmark = self.next_landmark;
-            let batch = focused_observations(&self.map, item, landmark);
+            let batch = self.map.observations_of(
+                &item.panorama,
+                Sighting::new(item.detection, landmark),
+                &item.decided,
+            );
             match self.map.fuse(&batch) {
                 Ok(_) => {
                     self.next_landmark += 1;
@@ -341,7 +342,7 @@ impl<C: Calculus> Mapper<C> {
                     let (station, detection) = (item.station, item.detection);
                     for other in pending.iter_mut().filter(|o| o.station == station) {
                         if other.detection != detection {
-                            other.decided.push((detection, landmark));
+                            other.decided.push(Sighting::new(detection, landmark));
                         }
                     }
                 }
@@ -379,32 +380,6 @@ impl<C: Calculus> Mapper<C> {
     }
 }
 
-/// Narrowest usable detection, columns (at least a 512th of the panorama): slivers are mostly
-/// pieces of larger rocks, whose centroids say little about where the rock is.
-const MIN_COLUMNS: u32 = 3;
-
-/// Tallest height-to-width ratio of a single rock's footprint: rocks are wider than they stand
-/// tall (on the marsyard and random presets no visible footprint exceeds 1.44, 99 % stay under
-/// 1.15). A taller blob is a farther rock seen over a nearer one, whose contact row (the
-/// nearer rock's) and centroid (between the two) belong to neither.
-const MAX_ASPECT: f64 = 1.5;
-
-fn stacked(d: &Detection) -> bool {
-    let width = f64::from(d.bbox[2] - d.bbox[0] + 1);
-    let height = f64::from(d.bbox[3] - d.bbox[1] + 1);
-    height > MAX_ASPECT * width
-}
-
-/// The physical width a detection implies for its rock (`ranging::width_evidence`), unless it
-/// is a part of a blob separated by parallax: a false cut of one large rock (its sides read
-/// farther than its middle) leaves a part narrower than the rock, which would bound the
-/// landmark's width too low and put the size cue's ranges too far.
-fn width_of(d: &Detection, ranged: &Ranged, model: &SensorModel) -> Option<RangeInterval> {
-    (d.separation == Separation::Whole)
-        .then(|| ranging::width_evidence(ranged, model))
-        .flatten()
-}
-
 /// Recent stations registered against (a rover moves a few metres between stations: the most
 /// recent ones share most landmarks with the current one).
 const RECENT_FRAMES: usize = 6;
@@ -414,79 +389,12 @@ const RECENT_FRAMES: usize = 6;
 /// observation resolved at a second retry, and every retry measures again.
 const HOLD_STATIONS: usize = 1;
 
-/// A detection's rough position around the station, if its range is bounded well enough to
-/// place it: the middle of its range interval along its bearing.
-fn placed(r: &Ranged) -> Option<Placed> {
-    let [low, high] = r.fused.as_array();
-    let middle = 0.5 * (low + high);
-    (high.is_finite() && high - low < middle).then(|| Placed {
-        point: [
-            middle * r.bearing.angle.cos(),
-            middle * r.bearing.angle.sin(),
-        ],
-        radius: 0.5 * (high - low) + high * r.bearing.uncertainty,
-    })
-}
-
 fn ratio(a: usize, b: usize) -> f64 {
     if b == 0 {
         0.0
     } else {
         a as f64 / b as f64
     }
-}
-
-/// The panorama of the detections at `usable` (bearings and the range order among them).
-fn panorama_of(ranged: &[Ranged], usable: &[usize]) -> Panorama {
-    let chosen: Vec<Ranged> = usable.iter().map(|&i| ranged[i]).collect();
-    let bearings: Vec<Bearing> = chosen.iter().map(|r| r.bearing).collect();
-    Panorama::new(bearings, ranging::range_order(&chosen))
-        .expect("bearings are finite, in range, with uncertainty below the limit")
-}
-
-/// The panorama restricted to `positions`.
-fn sub_panorama(panorama: &Panorama, positions: &[usize]) -> Panorama {
-    let bearings = positions.iter().map(|&p| panorama.bearings[p]).collect();
-    let pairs: Vec<(usize, usize)> = (0..positions.len())
-        .flat_map(|a| (0..positions.len()).map(move |b| (a, b)))
-        .filter(|&(a, b)| a != b && panorama.order.is_nearer(positions[a], positions[b]))
-        .collect();
-    let order = qrm_core::measurement::RangeOrder::from_pairs(positions.len(), &pairs)
-        .expect("a restriction of a strict order is one");
-    Panorama::new(bearings, order).expect("a restriction of a valid panorama is valid")
-}
-
-/// The held-back detection's triples with the station's fused detections, as `landmark`.
-fn focused_observations<C: Calculus>(
-    map: &Hypergraph<C>,
-    item: &HeldBack,
-    landmark: LandmarkId,
-) -> Vec<Observation> {
-    let decided = &item.decided;
-    let pairs: Vec<(usize, usize)> = (0..decided.len())
-        .flat_map(|x| (x + 1..decided.len()).map(move |y| (x, y)))
-        .collect();
-    pairs
-        .par_iter()
-        .flat_map_iter(|&(x, y)| {
-            let (p, q) = (decided[x], decided[y]);
-            let ids = [landmark, p.1, q.1];
-            let open = |a, b, c| map.relation(a, b, c).unwrap_or(C::universe());
-            let states: [RelationSet; 3] = item.panorama.measure_triple::<C>(
-                [item.detection, p.0, q.0],
-                [
-                    open(ids[0], ids[1], ids[2]),
-                    open(ids[1], ids[2], ids[0]),
-                    open(ids[2], ids[0], ids[1]),
-                ],
-            );
-            [
-                Observation::new(ids[0], ids[1], ids[2], states[0]),
-                Observation::new(ids[1], ids[2], ids[0], states[1]),
-                Observation::new(ids[2], ids[0], ids[1], states[2]),
-            ]
-        })
-        .collect()
 }
 
 fn detection_record(d: &Detection, r: &Ranged) -> DetectionRecord {
@@ -507,4 +415,58 @@ fn detection_record(d: &Detection, r: &Ranged) -> DetectionRecord {
         },
         association: Association::Unused,
     }
+}
+
+/// A station after association: its usable detections (indices into its primary detections,
+/// by position in its panorama), the evidence and decision of each, and what follows for the
+/// map: the sightings to fuse, new landmarks numbered from the map's next id, and the
+/// detections to hold back with their candidates.
+struct Associated {
+    usable: Vec<usize>,
+    evidence: Vec<Evidence>,
+    decisions: Vec<Decision>,
+    fused: Vec<Sighting>,
+    held: Vec<(usize, Vec<LandmarkId>)>,
+    /// The map's next landmark id once the new ones are fused.
+    next_landmark: LandmarkId,
+}
+
+impl Associated {
+    fn new(
+        usable: Vec<usize>,
+        evidence: Vec<Evidence>,
+        decisions: Vec<Decision>,
+        mut next_landmark: LandmarkId,
+    ) -> Associated {
+        let mut fused = Vec::new();
+        let mut held = Vec::new();
+        for (position, decision) in decisions.iter().enumerate() {
+            match decision {
+                Decision::Matched(l) => fused.push(Sighting::new(position, *l)),
+                Decision::New => {
+                    fused.push(Sighting::new(position, next_landmark));
+                    next_landmark += 1;
+                }
+                Decision::HeldBack(candidates) => held.push((position, candidates.clone())),
+            }
+        }
+        Associated {
+            usable,
+            evidence,
+            decisions,
+            fused,
+            held,
+            next_landmark,
+        }
+    }
+}
+
+/// The asserted "nearer than" pairs of the panorama, as indices into the station's primary
+/// detections.
+fn asserted_order(panorama: &Panorama, usable: &[usize]) -> Vec<(usize, usize)> {
+    (0..usable.len())
+        .flat_map(|a| (0..usable.len()).map(move |b| (a, b)))
+        .filter(|&(a, b)| panorama.order.is_nearer(a, b))
+        .map(|(a, b)| (usable[a], usable[b]))
+        .collect()
 }

@@ -1,12 +1,18 @@
-//! `pipeline run`: panoramas in, a qualitative map and its RNG out (000 §IV, §VI-C).
+//! `pipeline run`: panoramas in, a qualitative map and its RNG out (000 §IV, §VI-C):
+//! [`detect_survey`], then [`map_stations`] with a [`Mapper`].
 
 pub mod front_end;
 mod mapper;
 mod record;
+mod selection;
 mod summary;
+mod traverse;
 
 pub use mapper::{LandmarkRecord, Mapper, StationDetections};
 pub use summary::RunSummary;
+pub use traverse::{
+    detect_survey, map_stations, Detected, Progress, Quiet, RunError, RunSettings, Stage, Traverse,
+};
 
 pub use record::{
     Association, DetectionRecord, FusionRecord, MetricsRecord, RangeRecord, StageSeconds,
