@@ -7,10 +7,10 @@
 //! right panorama, blobs of a nearer and a farther rock are also separated by parallax.
 
 use qrm_synth::dataset::{visible_rocks, Counts, Preset, Truth};
-use qrm_synth::detection_score::{median_and_max, Score};
+use qrm_synth::evaluation::{median_and_max, Detectable, DetectedBox, Score};
 use qrm_synth::{render, Eye, World};
 use qrm_vision::calib::Calibration;
-use qrm_vision::detection::{detect, DetectorSettings};
+use qrm_vision::detection::{detect, Detection, DetectorSettings};
 
 fn calibration() -> Calibration {
     qrm_synth::default_calibration()
@@ -27,23 +27,34 @@ fn score_stations(preset: Preset, stations: &[usize]) -> Score {
         let r = render(&world, &calib, pose, Eye::Left);
         let truth = visible_rocks(&world, &calib, pose, Eye::Left, &r);
         let image = image::RgbImage::from_raw(r.width, r.height, r.rgb).unwrap();
+        let found = detect(&image, None, &calib, &settings);
         score.add(
-            &detect(&image, None, &calib, &settings),
+            &boxes(&unambiguous(found)),
             &truth,
             &calib,
-            &settings,
+            Detectable::of(&settings),
         );
     }
     score
+}
+
+/// The detections whose bearing the run may use: the figures these tests hold the detector
+/// to (`pipeline eval` scores every detection).
+fn unambiguous(found: Vec<Detection>) -> Vec<Detection> {
+    found.into_iter().filter(|d| !d.ambiguous).collect()
+}
+
+fn boxes(detections: &[Detection]) -> Vec<DetectedBox> {
+    detections.iter().map(DetectedBox::from).collect()
 }
 
 fn check(score: &Score, precision: f64, recall: f64) {
     let (bearing, _) = median_and_max(&score.bearing_errors);
     let (contact, _) = median_and_max(&score.contact_errors);
     println!(
-        "{} detectable, {} found, {} false, {} splits, {} merged, {} ambiguous, {} outside the bearing bound: precision {:.3} recall {:.3} bearing median {bearing:.2} px contact median {contact:.2} px",
+        "{} detectable, {} found, {} false, {} splits, {} merged, {} outside the bearing bound: precision {:.3} recall {:.3} bearing median {bearing:.2} px contact median {contact:.2} px",
         score.detectable, score.found, score.false_alarms, score.splits, score.merged,
-        score.ambiguous, score.outside_bound,
+        score.outside_bound,
         score.precision(),
         score.recall()
     );
@@ -63,24 +74,13 @@ fn check(score: &Score, precision: f64, recall: f64) {
     );
 }
 
-/// Scores of `preset`'s `stations` detected alone and with the right panorama, every
-/// detection counted (ambiguous ones too, as `pipeline run`'s evaluation does): parallax
-/// separation adds pieces that may be partly hidden, which the plain score leaves out.
+/// Scores of `preset`'s `stations` detected alone and with the right panorama.
 fn mono_and_stereo(preset: Preset, stations: &[usize]) -> (Score, Score) {
     let calib = calibration();
     let layout = preset.layout(7, Counts::default());
     let world = World::generate(7, &layout.rocks);
     let settings = DetectorSettings::default();
     let (mut mono, mut stereo) = (Score::default(), Score::default());
-    let counted = |found: Vec<qrm_vision::detection::Detection>| {
-        found
-            .into_iter()
-            .map(|d| qrm_vision::detection::Detection {
-                ambiguous: false,
-                ..d
-            })
-            .collect::<Vec<_>>()
-    };
     for &k in stations {
         let pose = layout.stations[k];
         let left = render(&world, &calib, pose, Eye::Left);
@@ -88,10 +88,10 @@ fn mono_and_stereo(preset: Preset, stations: &[usize]) -> (Score, Score) {
         let left = image::RgbImage::from_raw(left.width, left.height, left.rgb).unwrap();
         let right = render(&world, &calib, pose, Eye::Right);
         let right = image::RgbImage::from_raw(right.width, right.height, right.rgb).unwrap();
-        let alone = counted(detect(&left, None, &calib, &settings));
-        let paired = counted(detect(&left, Some(&right), &calib, &settings));
-        mono.add(&alone, &truth, &calib, &settings);
-        stereo.add(&paired, &truth, &calib, &settings);
+        let alone = boxes(&detect(&left, None, &calib, &settings));
+        let paired = boxes(&detect(&left, Some(&right), &calib, &settings));
+        mono.add(&alone, &truth, &calib, Detectable::of(&settings));
+        stereo.add(&paired, &truth, &calib, Detectable::of(&settings));
     }
     (mono, stereo)
 }
@@ -153,10 +153,10 @@ fn demo_set_low_resolution() {
             .unwrap()
             .into_rgb8();
         score.add(
-            &detect(&image, None, &calib, &settings),
+            &boxes(&unambiguous(detect(&image, None, &calib, &settings))),
             &t.rocks,
             &calib,
-            &settings,
+            Detectable::of(&settings),
         );
     }
     check(&score, 0.97, 0.5);

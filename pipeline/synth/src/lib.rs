@@ -12,7 +12,6 @@
 //! pixel depends only on its coordinates).
 
 pub mod dataset;
-pub mod detection_score;
 pub mod evaluation;
 
 mod ellipsoid;

@@ -59,7 +59,7 @@ struct Args {
 /// does (a left panorama with its right partner, for parallax), and prints the decode and
 /// detection time per image and, with `truth.json`, the detector's score.
 fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
-    use qrm_synth::detection_score::{median_and_max, Score};
+    use qrm_synth::evaluation::{median_and_max, Detectable, DetectedBox, Score};
     use qrm_vision::detection::{detect, DetectorSettings};
     let calib = qrm_vision::calib::Calibration::load(&dir.join("calib.toml"))?;
     let truth: Option<qrm_synth::dataset::Truth> =
@@ -75,6 +75,7 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
     let settings = DetectorSettings::default();
     let (mut decode, mut detecting) = (0.0, Vec::new());
     let mut score = Score::default();
+    let mut ambiguous = 0;
     for file in &files {
         let start = Instant::now();
         let image = image::open(file)?.into_rgb8();
@@ -98,7 +99,9 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
             .as_ref()
             .and_then(|t| t.images.iter().find(|i| i.file == name))
         {
-            score.add(&found, &t.rocks, &calib, &settings);
+            let boxes: Vec<DetectedBox> = found.iter().map(DetectedBox::from).collect();
+            score.add(&boxes, &t.rocks, &calib, Detectable::of(&settings));
+            ambiguous += found.iter().filter(|d| d.ambiguous).count();
         }
     }
     let n = files.len().max(1) as f64;
@@ -117,8 +120,8 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
         let (bearing_median, bearing_max) = median_and_max(&score.bearing_errors);
         let (contact_median, contact_max) = median_and_max(&score.contact_errors);
         println!(
-            "detect: {} detectable, {} found, {} false, {} splits, {} merged, {} ambiguous: precision {:.3}, recall {:.3}",
-            score.detectable, score.found, score.false_alarms, score.splits, score.merged, score.ambiguous,
+            "detect (matched as `pipeline eval` does): {} detectable, {} found, {} false, {} splits, {} merged, {ambiguous} flagged ambiguous: precision {:.3}, recall {:.3}",
+            score.detectable, score.found, score.false_alarms, score.splits, score.merged,
             score.precision(), score.recall()
         );
         println!(

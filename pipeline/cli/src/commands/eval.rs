@@ -77,10 +77,7 @@ pub fn score_run_files(
         },
         &truth,
         calib,
-        Detectable {
-            min_width_m: settings.min_width_m,
-            max_range_m: settings.max_range_m,
-        },
+        Detectable::of(&settings),
     );
     write_atomic(
         &out.join("eval.json"),

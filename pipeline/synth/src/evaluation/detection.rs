@@ -1,0 +1,239 @@
+//! Which truth rock each detection shows, and the detection figures that follow: the one
+//! matching rule of `pipeline eval`, the benchmarks and the tests, so that all of them report
+//! the same precision and recall for the same detections.
+
+use crate::dataset::VisibleRock;
+use qrm_vision::calib::Calibration;
+use qrm_vision::detection::{Detection, DetectorSettings};
+use qrm_vision::run::DetectionRecord;
+
+/// Which truth rocks a detector is expected to find.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Detectable {
+    pub min_width_m: f64,
+    pub max_range_m: f64,
+}
+
+impl Detectable {
+    pub fn of(settings: &DetectorSettings) -> Detectable {
+        Detectable {
+            min_width_m: settings.min_width_m,
+            max_range_m: settings.max_range_m,
+        }
+    }
+
+    /// Whether `rock`'s visible footprint is at least `min_width_m` wide and its range within
+    /// `max_range_m`.
+    pub fn holds(&self, rock: &VisibleRock, calib: &Calibration) -> bool {
+        let width = f64::from(calib.image.width);
+        let columns = (f64::from(rock.bbox[2]) - f64::from(rock.bbox[0])).rem_euclid(width) + 1.0;
+        rock.range <= self.max_range_m
+            && columns * calib.column_width() * rock.range >= self.min_width_m
+    }
+}
+
+/// What matching needs of a detection, from the detector or from `stations.json`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DetectedBox {
+    pub centroid: [f64; 2],
+    /// `[col_min, row_min, col_max, row_max]`, inclusive; `col_max ≥ width` when it wraps.
+    pub bbox: [u32; 4],
+    pub contact_row: f64,
+}
+
+impl From<&Detection> for DetectedBox {
+    fn from(d: &Detection) -> DetectedBox {
+        DetectedBox {
+            centroid: d.centroid,
+            bbox: d.bbox,
+            contact_row: d.contact_row,
+        }
+    }
+}
+
+impl From<&DetectionRecord> for DetectedBox {
+    fn from(d: &DetectionRecord) -> DetectedBox {
+        DetectedBox {
+            centroid: d.centroid,
+            bbox: d.bbox,
+            contact_row: d.contact_row,
+        }
+    }
+}
+
+/// The rock (index into `rocks`) each detection is credited with. A detection claims the rock
+/// whose bounding box holds its centroid (a column of slack either side, half a row above and
+/// one and a half below), the nearest by centroid distance if several; a rock claimed by
+/// several detections is credited to the nearest, the others (splits) to none.
+pub fn match_detections(
+    detections: &[DetectedBox],
+    rocks: &[VisibleRock],
+    width: u32,
+) -> Vec<Option<usize>> {
+    let mut best: Vec<Option<(usize, f64)>> = vec![None; rocks.len()];
+    for (i, d) in detections.iter().enumerate() {
+        if let Some((rock, distance)) = claim(d, rocks, width) {
+            if best[rock].is_none_or(|(_, nearest)| distance < nearest) {
+                best[rock] = Some((i, distance));
+            }
+        }
+    }
+    let mut credited = vec![None; detections.len()];
+    for (rock, claimant) in best.iter().enumerate() {
+        if let Some((i, _)) = claimant {
+            credited[*i] = Some(rock);
+        }
+    }
+    credited
+}
+
+/// The rock a detection claims, with the distance between their centroids.
+fn claim(d: &DetectedBox, rocks: &[VisibleRock], width: u32) -> Option<(usize, f64)> {
+    rocks
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| in_columns(d.centroid[0], r.bbox, width))
+        .filter(|(_, r)| {
+            (f64::from(r.bbox[1]) - 0.5..=f64::from(r.bbox[3]) + 1.5).contains(&d.centroid[1])
+        })
+        .map(|(k, r)| {
+            let dc = column_gap(d.centroid[0], r.centroid[0], width);
+            (k, dc.hypot(d.centroid[1] - r.centroid[1]))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+fn column_gap(a: f64, b: f64, width: u32) -> f64 {
+    let w = f64::from(width);
+    let d = (a - b).rem_euclid(w);
+    d.min(w - d)
+}
+
+/// Whether `column` lies in the (possibly seam-wrapping) column span of `bbox`, with a column
+/// of slack either side.
+fn in_columns(column: f64, bbox: [u32; 4], width: u32) -> bool {
+    let w = f64::from(width);
+    let start = f64::from(bbox[0]);
+    let span = (f64::from(bbox[2]) - start).rem_euclid(w) + 1.0;
+    (column - start + 1.0).rem_euclid(w) <= span + 1.0
+}
+
+/// Detection figures over one or more images, by [`match_detections`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Score {
+    pub images: usize,
+    pub detections: usize,
+    /// Detections credited with a truth rock (detectable or not).
+    pub true_detections: usize,
+    /// Detectable truth rocks, and those credited with a detection.
+    pub detectable: usize,
+    pub found: usize,
+    /// Detections whose centroid lies on no rock.
+    pub false_alarms: usize,
+    /// Detections on a rock credited to a nearer detection.
+    pub splits: usize,
+    /// Detectable rocks not found whose centroid lies inside a detection's box (merged into
+    /// another rock's detection).
+    pub merged: usize,
+    /// |centroid column − truth bearing column| (pixels) of found detectable rocks.
+    pub bearing_errors: Vec<f64>,
+    /// |contact row − truth contact row| (pixels) of found rocks whose contact is in the image.
+    pub contact_errors: Vec<f64>,
+    /// Bearing error over detection width (columns) of found rocks.
+    pub bearing_ratios: Vec<f64>,
+    /// Found rocks whose bearing error exceeds the downstream bound `1 px + 0.3 × width`.
+    pub outside_bound: usize,
+}
+
+impl Score {
+    /// Adds one image; returns the rock (index into `rocks`) credited to each detection.
+    pub fn add(
+        &mut self,
+        detections: &[DetectedBox],
+        rocks: &[VisibleRock],
+        calib: &Calibration,
+        detectable: Detectable,
+    ) -> Vec<Option<usize>> {
+        let width = calib.image.width;
+        let credited = match_detections(detections, rocks, width);
+        self.images += 1;
+        self.detections += detections.len();
+        self.true_detections += credited.iter().flatten().count();
+        for (d, rock) in detections.iter().zip(&credited) {
+            if rock.is_none() {
+                match claim(d, rocks, width) {
+                    Some(_) => self.splits += 1,
+                    None => self.false_alarms += 1,
+                }
+            }
+        }
+        for (k, rock) in rocks.iter().enumerate() {
+            if !detectable.holds(rock, calib) {
+                continue;
+            }
+            self.detectable += 1;
+            match credited.iter().position(|c| *c == Some(k)) {
+                Some(i) => self.add_found(&detections[i], rock, calib),
+                None if detections.iter().any(|d| covers(d, rock, width)) => self.merged += 1,
+                None => {}
+            }
+        }
+        credited
+    }
+
+    fn add_found(&mut self, d: &DetectedBox, rock: &VisibleRock, calib: &Calibration) {
+        self.found += 1;
+        let error = column_gap(d.centroid[0], rock.bearing_column, calib.image.width);
+        let columns = f64::from(d.bbox[2] - d.bbox[0] + 1);
+        self.bearing_errors.push(error);
+        self.bearing_ratios.push(error / columns);
+        if error > 1.0 + 0.3 * columns {
+            self.outside_bound += 1;
+        }
+        if rock.contact[1] < f64::from(calib.image.height) {
+            self.contact_errors
+                .push((d.contact_row - rock.contact[1]).abs());
+        }
+    }
+
+    /// Found over detectable.
+    pub fn recall(&self) -> f64 {
+        ratio(self.found, self.detectable)
+    }
+
+    /// Credited detections over all detections.
+    pub fn precision(&self) -> f64 {
+        ratio(self.true_detections, self.detections)
+    }
+}
+
+/// Whether the rock's centroid lies inside the detection's box.
+fn covers(d: &DetectedBox, rock: &VisibleRock, width: u32) -> bool {
+    let w = f64::from(width);
+    let lo = f64::from(d.bbox[0]);
+    let mut hi = f64::from(d.bbox[2]) + 1.0;
+    if hi < lo {
+        hi += w;
+    }
+    (rock.centroid[0] - lo).rem_euclid(w) <= hi - lo
+        && rock.centroid[1] >= f64::from(d.bbox[1])
+        && rock.centroid[1] <= f64::from(d.bbox[3]) + 1.0
+}
+
+pub(super) fn ratio(a: usize, b: usize) -> f64 {
+    if b == 0 {
+        0.0
+    } else {
+        a as f64 / b as f64
+    }
+}
+
+/// Median and maximum of `values` (0 for none).
+pub fn median_and_max(values: &[f64]) -> (f64, f64) {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    (
+        v.get(v.len() / 2).copied().unwrap_or(0.0),
+        v.last().copied().unwrap_or(0.0),
+    )
+}

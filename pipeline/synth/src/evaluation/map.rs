@@ -1,0 +1,129 @@
+//! Scoring the map: the run's map and one built from exact measurements of the same landmarks
+//! at the same stations, against the classification of the true rock positions.
+
+use super::association::LandmarkRocks;
+use super::detection::ratio;
+use super::{eval_records, MapMetricsScore, MapScore, RngScore, RunFiles};
+use crate::dataset::Truth;
+use qrm_core::calculus::Calculus;
+use qrm_core::edc::Edc;
+use qrm_core::geometry::Point;
+use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
+use qrm_core::measurement::{Bearing, Panorama, RangeOrder};
+use qrm_core::metrics::evaluate;
+use qrm_core::neighborhood::{compare, estimate};
+use std::collections::HashMap;
+use std::f64::consts::TAU;
+
+pub(super) fn score(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> MapScore {
+    let rock = |id: u32| {
+        let p = truth.rocks[id as usize].position;
+        Point::new(p[0], p[1])
+    };
+    let defined = |l: LandmarkId| rocks.defined(l).is_some();
+    let position = |l: LandmarkId| rocks.defined(l).map(rock);
+    // Soundness of the run's map is checked on every landmark with a majority rock: a duplicate
+    // shares its rock's position (triples of two such landmarks are degenerate, so undefined),
+    // and a mixed landmark is held to its majority rock.
+    let majority_truth = |a: LandmarkId, b: LandmarkId, c: LandmarkId| {
+        let at = |l: LandmarkId| rocks.majority(l).map(rock);
+        Edc::classify(at(a)?, at(b)?, at(c)?)
+    };
+    let defined_truth = |a: LandmarkId, b: LandmarkId, c: LandmarkId| {
+        Edc::classify(position(a)?, position(b)?, position(c)?)
+    };
+    let exact = exact_map(run, truth, rocks);
+    MapScore {
+        run: map_score(run.map, &majority_truth, &defined),
+        exact: map_score(&exact, &defined_truth, &defined),
+        rng: estimate(run.map).and_then(|rng| {
+            if run.map.landmarks().iter().any(|&l| position(l).is_none()) {
+                return None;
+            }
+            let comparison = compare(run.map, &rng, |l| position(l).expect("checked"));
+            Some(RngScore {
+                precision: comparison.precision(),
+                recall: comparison.recall(),
+                true_edges_pruned: comparison.pruned_true,
+            })
+        }),
+    }
+}
+
+/// The map from exact measurements of the same landmarks at the same stations: true bearings
+/// from the station centre and the true total range order.
+fn exact_map(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> Hypergraph<Edc> {
+    let mut map = Hypergraph::<Edc>::new();
+    for (record, image) in eval_records(run.records, truth) {
+        let station = &truth.stations[image.station];
+        let mut ids: Vec<LandmarkId> = run
+            .landmarks
+            .iter()
+            .filter(|l| l.sightings.iter().any(|s| s.0 == record.index))
+            .map(|l| l.landmark)
+            .filter(|&l| rocks.defined(l).is_some())
+            .collect();
+        ids.sort_unstable();
+        if ids.len() < 3 {
+            continue;
+        }
+        let polar: Vec<(f64, f64)> = ids
+            .iter()
+            .map(|&l| {
+                let p = truth.rocks[rocks.defined(l).expect("filtered") as usize].position;
+                let (dx, dy) = (p[0] - station.position[0], p[1] - station.position[1]);
+                (
+                    (dy.atan2(dx) - station.heading).rem_euclid(TAU),
+                    dx.hypot(dy),
+                )
+            })
+            .collect();
+        let mut nearest_first: Vec<usize> = (0..ids.len()).collect();
+        nearest_first.sort_by(|&a, &b| polar[a].1.total_cmp(&polar[b].1));
+        let order = RangeOrder::total(&nearest_first).expect("a permutation");
+        let Ok(panorama) =
+            Panorama::new(polar.iter().map(|p| Bearing::exact(p.0)).collect(), order)
+        else {
+            continue;
+        };
+        let batch = map.observations(&panorama, &Sighting::all(&ids));
+        let _ = map.fuse(&batch);
+    }
+    map
+}
+
+fn map_score<C: Calculus>(
+    map: &Hypergraph<C>,
+    truth: &impl Fn(LandmarkId, LandmarkId, LandmarkId) -> Option<u8>,
+    defined: &dyn Fn(LandmarkId) -> bool,
+) -> MapMetricsScore {
+    let m = evaluate(map, truth, map.len());
+    let mut unsound: HashMap<LandmarkId, usize> = HashMap::new();
+    let (mut open, mut states) = (0usize, 0usize);
+    for (a, b, c, relations) in map.triples() {
+        if defined(a) && defined(b) && defined(c) {
+            open += relations.iter().map(|s| s.len()).sum::<usize>();
+            states += 3 * C::universe().len();
+        }
+        for (set, (x, y, z)) in relations.iter().zip([(a, b, c), (b, c, a), (c, a, b)]) {
+            if truth(x, y, z).is_some_and(|t| !set.contains(t)) {
+                for l in [x, y, z] {
+                    *unsound.entry(l).or_default() += 1;
+                }
+            }
+        }
+    }
+    let mut unsound_landmarks: Vec<(LandmarkId, usize)> = unsound.into_iter().collect();
+    unsound_landmarks.sort_by_key(|&(l, n)| (std::cmp::Reverse(n), l));
+    MapMetricsScore {
+        unsound_landmarks,
+        landmarks: map.len(),
+        triples: map.triple_count(),
+        open_pct: m.open_pct,
+        open_pct_defined: 100.0 * ratio(open, states),
+        removed_incorrect_pct: m.removed_incorrect_pct,
+        fully_constrained_pct: m.fully_constrained_pct,
+        unsound_relations: m.unsound_relations,
+        undefined_triples: m.undefined_triples,
+    }
+}

@@ -1,0 +1,231 @@
+//! Scoring a `pipeline run` against the renderer's ground truth (`truth.json`): detection,
+//! bearings, range cues and order ([`front_end`]), association ([`association`]), and the map
+//! against one built from exact measurements of the same landmarks at the same stations
+//! ([`map`]). Pure: files are read and written by the CLI.
+
+mod association;
+pub mod detection;
+mod front_end;
+mod map;
+
+pub use detection::{match_detections, median_and_max, Detectable, DetectedBox, Score};
+
+use crate::dataset::{ImageTruth, Truth};
+use qrm_core::edc::Edc;
+use qrm_core::map::{Hypergraph, LandmarkId};
+use qrm_vision::calib::Calibration;
+use qrm_vision::run::{LandmarkRecord, StationRecord};
+use serde::Serialize;
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Evaluation {
+    pub detection: DetectionScore,
+    /// Bearings of every detection matched to a rock, and of those the run used (it sets
+    /// aside detections it doubts: possibly several rocks, slivers, pieces touching others).
+    pub bearing: BearingScore,
+    pub bearing_used: BearingScore,
+    pub range: RangeScore,
+    pub association: AssociationScore,
+    pub map: MapScore,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct DetectionScore {
+    pub images: usize,
+    pub detections: usize,
+    /// Detections that are the unique match of a truth rock.
+    pub true_detections: usize,
+    pub detectable: usize,
+    pub detectable_found: usize,
+    pub precision: f64,
+    pub recall: f64,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct BearingScore {
+    pub count: usize,
+    pub median_error_deg: f64,
+    pub worst_error_deg: f64,
+    /// Fraction of bearings whose interval holds the true bearing (must be 1 for soundness).
+    pub within_interval: f64,
+    /// Largest error / interval half-width (≤ 1 when sound).
+    pub worst_error_ratio: f64,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct CueScore {
+    pub count: usize,
+    /// Fraction of intervals holding the true range.
+    pub holds_truth: f64,
+    /// Median width of the finite intervals relative to the true range.
+    pub median_relative_width: f64,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RangeScore {
+    pub ground: CueScore,
+    pub stereo: CueScore,
+    pub size: CueScore,
+    pub fused: CueScore,
+    pub conflicts: usize,
+    /// Pairs of matched detections in the same panorama, pairs the order asserts, and
+    /// asserted pairs that are wrong (target 0).
+    pub pairs: usize,
+    pub asserted_pairs: usize,
+    pub wrong_pairs: usize,
+    /// All asserted pairs (matched to truth or not), those each cue separates on its own, and
+    /// those only the fused intervals separate.
+    pub asserted_all: usize,
+    pub separated_by_ground: usize,
+    pub separated_by_stereo: usize,
+    pub separated_by_size: usize,
+    pub separated_only_fused: usize,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct AssociationScore {
+    pub landmarks: usize,
+    pub sightings: usize,
+    /// Sightings of the rock their landmark stands for (its majority rock).
+    pub correct_sightings: usize,
+    pub accuracy: f64,
+    /// Rocks with more than one landmark, and landmarks whose sightings span several rocks.
+    pub duplicated_rocks: usize,
+    pub mixed_landmarks: usize,
+    /// Sightings of things that are not truth rocks (false detections).
+    pub unmatched_sightings: usize,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct MapScore {
+    pub run: MapMetricsScore,
+    pub exact: MapMetricsScore,
+    pub rng: Option<RngScore>,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct MapMetricsScore {
+    pub landmarks: usize,
+    pub triples: usize,
+    pub open_pct: f64,
+    /// Open states over the triples of landmarks that stand for one rock each (those the exact
+    /// map is built from): the like-for-like comparison, since landmarks of duplicated rocks,
+    /// mixed landmarks and false detections are seen at few stations and stay loose.
+    pub open_pct_defined: f64,
+    pub removed_incorrect_pct: f64,
+    pub fully_constrained_pct: f64,
+    /// Relations whose true state was removed (target 0).
+    pub unsound_relations: usize,
+    /// Landmarks in unsound relations, with how many each is in, most first: where to look
+    /// for a wrong association or a bad measurement.
+    pub unsound_landmarks: Vec<(LandmarkId, usize)>,
+    pub undefined_triples: usize,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RngScore {
+    pub precision: f64,
+    pub recall: f64,
+    pub true_edges_pruned: usize,
+}
+
+/// Checks that `truth`, `records` and `landmarks` (read from files) refer to each other
+/// consistently, so that scoring can index them: every image's station and rock exist, every
+/// order pair and sighting names an existing detection.
+pub fn check_files(
+    truth: &Truth,
+    records: &[StationRecord],
+    landmarks: &[LandmarkRecord],
+) -> Result<(), String> {
+    for image in &truth.images {
+        if image.station >= truth.stations.len() {
+            return Err(format!(
+                "image {} names station {} of {}",
+                image.file,
+                image.station,
+                truth.stations.len()
+            ));
+        }
+        if let Some(rock) = image
+            .rocks
+            .iter()
+            .find(|r| r.id as usize >= truth.rocks.len())
+        {
+            return Err(format!(
+                "image {} shows rock {} of {}",
+                image.file,
+                rock.id,
+                truth.rocks.len()
+            ));
+        }
+    }
+    for record in records {
+        let n = record.detections.len();
+        if let Some(&(i, j)) = record.order.iter().find(|&&(i, j)| i >= n || j >= n) {
+            return Err(format!(
+                "station {} orders detections ({i}, {j}) of {n}",
+                record.station
+            ));
+        }
+    }
+    for landmark in landmarks {
+        for &(station, detection) in &landmark.sightings {
+            let exists = records
+                .iter()
+                .find(|r| r.index == station)
+                .is_some_and(|r| detection < r.detections.len());
+            if !exists {
+                return Err(format!(
+                    "landmark {} was sighted at station {station}, detection {detection}, which the run does not have",
+                    landmark.landmark
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Everything `score_run` needs, read by the caller.
+pub struct RunFiles<'a> {
+    pub records: &'a [StationRecord],
+    pub landmarks: &'a [LandmarkRecord],
+    pub map: &'a Hypergraph<Edc>,
+}
+
+/// Scores a run. `detectable` says which rocks count for recall.
+pub fn score_run(
+    run: &RunFiles,
+    truth: &Truth,
+    calib: &Calibration,
+    detectable: Detectable,
+) -> Evaluation {
+    let mut tally = front_end::Tally::default();
+    for (record, image) in eval_records(run.records, truth) {
+        tally.add_image(record, image, truth, calib, detectable);
+    }
+    let (detection, bearing, bearing_used, range) = tally.scores();
+    let (association, rocks) = association::score(run.landmarks, &tally.matched);
+    Evaluation {
+        detection,
+        bearing,
+        bearing_used,
+        range,
+        association,
+        map: map::score(run, truth, &rocks),
+    }
+}
+
+/// The run's records paired with the truth of their primary image.
+fn eval_records<'a>(
+    records: &'a [StationRecord],
+    truth: &'a Truth,
+) -> Vec<(&'a StationRecord, &'a ImageTruth)> {
+    records
+        .iter()
+        .filter_map(|r| {
+            let file = r.files.first()?;
+            let image = truth.images.iter().find(|i| &i.file == file)?;
+            Some((r, image))
+        })
+        .collect()
+}
