@@ -150,7 +150,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
     let mut recorders = recorders(&args)?;
-    let mapper: Mapper<Edc> = Mapper::new(calib.clone(), settings.sensor, settings.association);
+    let mapper: Mapper<Edc> = Mapper::new(calib, settings.sensor, settings.association);
     let traverse = map_stations(&detected, mapper, &bars, |record, mapper| {
         record_station(&mut recorders, record, &mapper.map, &survey, &calib)
     })?;
