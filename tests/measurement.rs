@@ -6,7 +6,7 @@ use qrm_core::calculus::{Calculus, RelationSet};
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
 use qrm_core::geometry::Point;
-use qrm_core::measurement::{Bearing, Panorama, RangeOrder};
+use qrm_core::measurement::{Bearing, RangeOrder, StationView};
 use qrm_tests::{random_point, rng};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -16,7 +16,7 @@ use rayon::prelude::*;
 /// `±delta` and a random subset of the true range order.
 struct Scene {
     landmarks: [Point; 3],
-    panorama: Panorama,
+    panorama: StationView,
 }
 
 fn random_scene(rng: &mut ChaCha8Rng, delta: f64) -> Scene {
@@ -53,7 +53,7 @@ fn random_scene(rng: &mut ChaCha8Rng, delta: f64) -> Scene {
     let order = RangeOrder::from_pairs(3, &pairs).expect("true order is acyclic");
     Scene {
         landmarks,
-        panorama: Panorama::new(bearings, order).expect("valid panorama"),
+        panorama: StationView::new(bearings, order).expect("valid panorama"),
     }
 }
 
@@ -217,7 +217,7 @@ fn narrow_cusp_near_a_is_not_skipped() {
         Bearing::exact(1e-6),
     ];
     let order = RangeOrder::from_pairs(3, &[(1, 0), (0, 2)]).unwrap();
-    let panorama = Panorama::new(bearings, order).unwrap();
+    let panorama = StationView::new(bearings, order).unwrap();
     let measured = panorama.measure_triple::<Edc>([0, 1, 2], [Edc::universe(); 3]);
     assert!(measured[0].contains(15), "AB:C = {}", measured[0]);
 }

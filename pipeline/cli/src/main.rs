@@ -1,6 +1,8 @@
-//! `pipeline`: the qrm command line. Until the vision front end lands, it exposes the calculus
-//! core (classification, the operators, table statistics, a demo of 000 §III-C), measurement of
-//! single triples, simulated mapping and map files.
+//! `pipeline`: the qrm command line, thin glue over the qrm crates (docs/ARCHITECTURE.md): the
+//! calculus (classification, the operators, table statistics, a demo of 000 §III-C),
+//! measurement of single triples, simulated mapping, map files, synthetic datasets, and
+//! `pipeline run` / `eval` over directories of panoramas. Argument parsing, progress bars,
+//! recordings and output files live here; the work is done by the libraries.
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -18,8 +20,8 @@ use commands::CalculusName;
 #[command(
     name = "pipeline",
     version,
-    about = "Qualitative relational mapping (McClelland, Campbell, Estlin): EDC/FDC calculus tools",
-    long_about = "Qualitative relational mapping (McClelland, Campbell, Estlin).\n\n\
+    about = "qrm: qualitative relational mapping (McClelland, Campbell, Estlin) from rover panoramas",
+    long_about = "qrm: qualitative relational mapping (McClelland, Campbell, Estlin) from rover panoramas.\n\n\
         Relations are numbered as in the papers: EDC regions 1..20 (000 Fig. 3b), FDC relations \
         1..15 (003 §1.2). Sets are written {1,5,11} or 1,5,11."
 )]

@@ -13,7 +13,7 @@ use qrm_core::fdc::Fdc;
 use qrm_core::feasibility::{BranchAndBound, Outcome, Quadratic};
 use qrm_core::geometry::Point;
 use qrm_core::map::{Hypergraph, Observation};
-use qrm_core::measurement::{Bearing, Panorama, RangeOrder};
+use qrm_core::measurement::{Bearing, RangeOrder, StationView};
 use qrm_tools::{edc_composition, edc_unary, fdc_composition, fdc_unary};
 use rand::{Rng, SeedableRng};
 use std::time::Instant;
@@ -218,7 +218,7 @@ fn bench_measure(n: usize, uncertainty_deg: f64) {
             .total_cmp(&points[j].distance(Point::new(0.0, 0.0)))
     });
     let order = RangeOrder::total(&nearest_first).expect("a chain is acyclic");
-    let panorama = Panorama::new(bearings, order).expect("valid panorama");
+    let panorama = StationView::new(bearings, order).expect("valid panorama");
     let mut times = Vec::new();
     let mut open = 0usize;
     let mut relations = 0usize;

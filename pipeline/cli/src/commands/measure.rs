@@ -6,7 +6,7 @@ use clap::Args;
 use qrm_core::calculus::{Calculus, RelationSet};
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
-use qrm_core::measurement::{Bearing, Panorama, RangeOrder, MAX_BEARING_UNCERTAINTY};
+use qrm_core::measurement::{Bearing, RangeOrder, StationView, MAX_BEARING_UNCERTAINTY};
 
 #[derive(Args, Debug)]
 pub struct MeasureArgs {
@@ -68,7 +68,7 @@ pub fn run(args: MeasureArgs) -> Result<()> {
             uncertainty: args.uncertainty.to_radians(),
         })
         .collect();
-    let panorama = Panorama::new(bearings, order)?;
+    let panorama = StationView::new(bearings, order)?;
     match args.calculus {
         CalculusName::Edc => print::<Edc>(&panorama),
         CalculusName::Fdc => print::<Fdc>(&panorama),
@@ -76,7 +76,7 @@ pub fn run(args: MeasureArgs) -> Result<()> {
     Ok(())
 }
 
-fn print<C: Calculus>(panorama: &Panorama) {
+fn print<C: Calculus>(panorama: &StationView) {
     let [ab_c, bc_a, ca_b] = panorama.measure_triple::<C>([0, 1, 2], [C::universe(); 3]);
     let inverse = |s: RelationSet| C::tables().inverse(s);
     println!("AB:C = {ab_c}");

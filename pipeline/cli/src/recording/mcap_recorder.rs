@@ -138,6 +138,12 @@ impl McapRecorder {
     }
 
     fn write_station(&mut self, r: &StationRecord) -> Result<(), Problem> {
+        self.write_front_end(r)?;
+        self.write_mapping(r)
+    }
+
+    /// The detections, bearings and range evidence of one station.
+    fn write_front_end(&mut self, r: &StationRecord) -> Result<(), Problem> {
         let (index, station) = (r.index, r.station.as_str());
         let detections = r.detections.iter().enumerate();
         self.write(
@@ -194,14 +200,22 @@ impl McapRecorder {
                     .collect(),
                 nearer: &r.order,
             },
-        )?;
+        )
+    }
+
+    /// Association, fusion and the map's state after one station.
+    fn write_mapping(&mut self, r: &StationRecord) -> Result<(), Problem> {
+        let (index, station) = (r.index, r.station.as_str());
         self.write(
             Topic::Association,
             index,
             &AssociationMessage {
                 index,
                 station,
-                associations: detections
+                associations: r
+                    .detections
+                    .iter()
+                    .enumerate()
                     .map(|(detection, d)| Decision {
                         detection,
                         association: &d.association,

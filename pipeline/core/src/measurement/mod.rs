@@ -48,10 +48,11 @@ impl Bearing {
     }
 }
 
-/// What one panorama tells about the landmarks it shows: bearings (000 §IV assumption 1) and
-/// the range ordering (assumption 2), indexed by position in `bearings`.
+/// What one station sees of the landmarks in its panorama: bearings (000 §IV assumption 1) and
+/// the range ordering (assumption 2), indexed by position in `bearings`. Not the image: the
+/// vision crate turns images into views.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Panorama {
+pub struct StationView {
     pub bearings: Vec<Bearing>,
     pub order: RangeOrder,
 }
@@ -71,8 +72,8 @@ pub enum MeasurementError {
     OrderSize { order: usize, bearings: usize },
 }
 
-impl Panorama {
-    pub fn new(bearings: Vec<Bearing>, order: RangeOrder) -> Result<Panorama, MeasurementError> {
+impl StationView {
+    pub fn new(bearings: Vec<Bearing>, order: RangeOrder) -> Result<StationView, MeasurementError> {
         for (index, b) in bearings.iter().enumerate() {
             if !b.angle.is_finite() {
                 return Err(MeasurementError::BearingNotFinite {
@@ -101,7 +102,7 @@ impl Panorama {
                 bearings: bearings.len(),
             });
         }
-        Ok(Panorama { bearings, order })
+        Ok(StationView { bearings, order })
     }
 
     pub fn len(&self) -> usize {

@@ -3,7 +3,7 @@
 
 use crate::geometry::Point;
 use crate::map::LandmarkId;
-use crate::measurement::{Bearing, Panorama, RangeOrder};
+use crate::measurement::{Bearing, RangeOrder, StationView};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
@@ -39,7 +39,7 @@ impl Sensor {
         landmarks: &[Point],
         station: Point,
         rng: &mut ChaCha8Rng,
-    ) -> (Vec<LandmarkId>, Panorama) {
+    ) -> (Vec<LandmarkId>, StationView) {
         let mut by_range: Vec<usize> = (0..landmarks.len()).collect();
         by_range.sort_by(|&i, &j| {
             landmarks[i]
@@ -47,7 +47,7 @@ impl Sensor {
                 .total_cmp(&landmarks[j].distance(station))
         });
         by_range.truncate(self.nearest.unwrap_or(landmarks.len()));
-        // Panorama positions follow the (possibly corrupted) range order, nearest first.
+        // Positions in the view follow the (possibly corrupted) range order, nearest first.
         let mut nearest_first: Vec<usize> = (0..by_range.len()).collect();
         for k in 1..nearest_first.len() {
             if rng.random_bool(self.order_swap_probability) {
@@ -70,7 +70,7 @@ impl Sensor {
             })
             .collect();
         let order = RangeOrder::total(&nearest_first).expect("a permutation is a chain");
-        let panorama = Panorama::new(bearings, order).expect("simulated bearings are valid");
+        let panorama = StationView::new(bearings, order).expect("simulated bearings are valid");
         (
             by_range.iter().map(|&i| i as LandmarkId).collect(),
             panorama,

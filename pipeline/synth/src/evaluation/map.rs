@@ -9,7 +9,7 @@ use qrm_core::calculus::Calculus;
 use qrm_core::edc::Edc;
 use qrm_core::geometry::Point;
 use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
-use qrm_core::measurement::{Bearing, Panorama, RangeOrder};
+use qrm_core::measurement::{Bearing, RangeOrder, StationView};
 use qrm_core::metrics::evaluate;
 use qrm_core::neighborhood::{compare, estimate};
 use std::collections::HashMap;
@@ -82,7 +82,7 @@ fn exact_map(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> Hypergraph
         nearest_first.sort_by(|&a, &b| polar[a].1.total_cmp(&polar[b].1));
         let order = RangeOrder::total(&nearest_first).expect("a permutation");
         let Ok(panorama) =
-            Panorama::new(polar.iter().map(|p| Bearing::exact(p.0)).collect(), order)
+            StationView::new(polar.iter().map(|p| Bearing::exact(p.0)).collect(), order)
         else {
             continue;
         };

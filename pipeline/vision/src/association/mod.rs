@@ -35,7 +35,7 @@ use crate::detection::Appearance;
 use crate::ranging::RangeInterval;
 use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
-use qrm_core::measurement::Panorama;
+use qrm_core::measurement::StationView;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -87,10 +87,10 @@ pub struct Evidence {
 }
 
 /// One station as association sees it: the bearings and range order of its usable detections,
-/// and the evidence of the detection at each position of the panorama.
+/// and the evidence of the detection at each position of the view.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StationEvidence {
-    pub panorama: Panorama,
+    pub view: StationView,
     pub detections: Vec<Evidence>,
 }
 
@@ -111,7 +111,7 @@ pub fn associate<C: Calculus>(
     station: &StationEvidence,
     settings: &AssociationSettings,
 ) -> Vec<Decision> {
-    let (panorama, evidence) = (&station.panorama, &station.detections);
+    let (view, evidence) = (&station.view, &station.detections);
     let placed: Vec<Option<Placed>> = evidence.iter().map(|e| e.placed).collect();
     let n = evidence.len();
     if gallery.is_empty() {
@@ -121,6 +121,35 @@ pub fn associate<C: Calculus>(
         .iter()
         .map(|e| proposals(e, gallery, settings))
         .collect();
+    let registrations = registrations(frames, &placed, &candidates);
+    let mut anchors = anchors(&registrations, &candidates);
+    let candidates = placed_near(candidates, &registrations, &placed);
+    drop_inconsistent_anchors(map, view, &mut anchors);
+    let anchored: Vec<Sighting> = anchors.iter().map(|a| Sighting::new(a.0, a.1)).collect();
+    let recent = |l: LandmarkId| frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
+    (0..n)
+        .into_par_iter()
+        .map(|i| match anchored.iter().find(|a| a.position == i) {
+            Some(anchor) => Decision::Matched(anchor.landmark),
+            None => {
+                let survivors =
+                    survivors(map, view, i, &candidates[i], &anchored, &recent, settings);
+                if survivors.is_empty() {
+                    Decision::New
+                } else {
+                    Decision::HeldBack(survivors)
+                }
+            }
+        })
+        .collect()
+}
+
+/// The frames the station registers against, with their registrations (see [`register`]).
+fn registrations<'f>(
+    frames: &'f [Frame],
+    placed: &[Option<Placed>],
+    candidates: &[Vec<(LandmarkId, f64)>],
+) -> Vec<(&'f Frame, Registration)> {
     let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
     // Registration hypotheses grow with the square of the seeds: each detection seeds only
     // with its closest few look-alikes (the lists are sorted by descriptor distance).
@@ -130,14 +159,13 @@ pub fn associate<C: Calculus>(
             .take(REGISTRATION_SEEDS)
             .any(|c| c.0 == l)
     };
-    let recent = |l: LandmarkId| frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
     let registrations: Vec<(&Frame, Registration)> = frames
         .iter()
-        .filter_map(|frame| Some((frame, register(&placed, frame, &alike, &seed)?)))
+        .filter_map(|frame| Some((frame, register(placed, frame, &alike, &seed)?)))
         .collect();
     // A station's only registration is a chance fit of look-alikes when several other frames
     // hold enough of its landmarks to have found the same pairing and none did.
-    let registrations = match registrations.as_slice() {
+    match registrations.as_slice() {
         [(only, registration)]
             if frames
                 .iter()
@@ -148,9 +176,16 @@ pub fn associate<C: Calculus>(
             Vec::new()
         }
         _ => registrations,
-    };
-    // Registered correspondences of all frames; a detection or landmark given two different
-    // partners by different frames is left out.
+    }
+}
+
+/// The registered correspondences all frames agree on, `(detection, landmark, descriptor
+/// distance)`: a detection or landmark given two different partners by different frames is
+/// left out, and so is a pair that most frames holding its landmark do not make.
+fn anchors(
+    registrations: &[(&Frame, Registration)],
+    candidates: &[Vec<(LandmarkId, f64)>],
+) -> Vec<(usize, LandmarkId, f64)> {
     let mut pairs: Vec<(usize, LandmarkId)> = registrations
         .iter()
         .flat_map(|(_, r)| r.pairs.iter().copied())
@@ -171,17 +206,24 @@ pub fn associate<C: Calculus>(
             .count();
         2 * support > holding
     };
-    let mut anchors: Vec<(usize, LandmarkId, f64)> = pairs
+    pairs
         .iter()
         .filter(|p| !conflicted(p) && agreed(p))
         .map(|&(i, l)| {
             let d = candidates[i].iter().find(|c| c.0 == l).map_or(0.0, |c| c.1);
             (i, l, d)
         })
-        .collect();
-    // A registered frame also rules out, for each detection, the frame's landmarks that lie
-    // away from where the motion puts it.
-    let candidates: Vec<Vec<(LandmarkId, f64)>> = candidates
+        .collect()
+}
+
+/// The candidates of each detection less those a registered frame places away from where its
+/// motion puts the detection.
+fn placed_near(
+    candidates: Vec<Vec<(LandmarkId, f64)>>,
+    registrations: &[(&Frame, Registration)],
+    placed: &[Option<Placed>],
+) -> Vec<Vec<(LandmarkId, f64)>> {
+    candidates
         .into_iter()
         .enumerate()
         .map(|(i, list)| {
@@ -200,31 +242,6 @@ pub fn associate<C: Calculus>(
                 })
                 .collect()
         })
-        .collect();
-    drop_inconsistent_anchors(map, panorama, &mut anchors);
-    let anchored: Vec<Sighting> = anchors.iter().map(|a| Sighting::new(a.0, a.1)).collect();
-
-    (0..n)
-        .into_par_iter()
-        .map(|i| match anchored.iter().find(|a| a.position == i) {
-            Some(anchor) => Decision::Matched(anchor.landmark),
-            None => {
-                let survivors = survivors(
-                    map,
-                    panorama,
-                    i,
-                    &candidates[i],
-                    &anchored,
-                    &recent,
-                    settings,
-                );
-                if survivors.is_empty() {
-                    Decision::New
-                } else {
-                    Decision::HeldBack(survivors)
-                }
-            }
-        })
         .collect()
 }
 
@@ -238,7 +255,7 @@ pub fn associate<C: Calculus>(
 /// a lone pass, since the rock's own landmark need not have been among the look-alikes.
 pub fn reconsider<C: Calculus>(
     map: &Hypergraph<C>,
-    panorama: &Panorama,
+    view: &StationView,
     detection: usize,
     candidates: &[LandmarkId],
     decided: &[Sighting],
@@ -254,7 +271,7 @@ pub fn reconsider<C: Calculus>(
     }
     Some(survivors(
         map,
-        panorama,
+        view,
         detection,
         &open,
         decided,
@@ -293,7 +310,7 @@ fn proposals(
 /// nothing on this triple.
 fn triple_consistency<C: Calculus>(
     map: &Hypergraph<C>,
-    panorama: &Panorama,
+    view: &StationView,
     detections: [usize; 3],
     ids: [LandmarkId; 3],
 ) -> Option<bool> {
@@ -306,14 +323,14 @@ fn triple_consistency<C: Calculus>(
     if open.iter().all(|r| *r == C::universe()) {
         return None;
     }
-    let measured = panorama.measure_triple::<C>(detections, open);
+    let measured = view.measure_triple::<C>(detections, open);
     Some(measured.iter().all(|r| !r.is_empty()))
 }
 
 /// Drops anchors until every triple of anchors the map knows is consistent.
 fn drop_inconsistent_anchors<C: Calculus>(
     map: &Hypergraph<C>,
-    panorama: &Panorama,
+    view: &StationView,
     anchors: &mut Vec<(usize, LandmarkId, f64)>,
 ) {
     loop {
@@ -323,7 +340,7 @@ fn drop_inconsistent_anchors<C: Calculus>(
             for y in x + 1..k {
                 for z in y + 1..k {
                     let (p, q, r) = (anchors[x], anchors[y], anchors[z]);
-                    if triple_consistency(map, panorama, [p.0, q.0, r.0], [p.1, q.1, r.1])
+                    if triple_consistency(map, view, [p.0, q.0, r.0], [p.1, q.1, r.1])
                         == Some(false)
                     {
                         failures[x] += 1;
@@ -351,7 +368,7 @@ fn drop_inconsistent_anchors<C: Calculus>(
 /// 000 §VI-C for one detection: the candidates the map does not reject.
 fn survivors<C: Calculus>(
     map: &Hypergraph<C>,
-    panorama: &Panorama,
+    view: &StationView,
     detection: usize,
     candidates: &[(LandmarkId, f64)],
     anchors: &[Sighting],
@@ -363,8 +380,7 @@ fn survivors<C: Calculus>(
         .iter()
         .filter(|c| !taken(c.0))
         .filter_map(|&(landmark, _)| {
-            let informative =
-                test_candidate(map, panorama, detection, landmark, anchors, settings)?;
+            let informative = test_candidate(map, view, detection, landmark, anchors, settings)?;
             // A landmark not seen lately stays a candidate only on evidence the map actually
             // constrains: otherwise every unknown rock would be held back for every old
             // look-alike, and the map would stop growing.
@@ -377,7 +393,7 @@ fn survivors<C: Calculus>(
 /// otherwise the number of triples on which the map constrained the test.
 fn test_candidate<C: Calculus>(
     map: &Hypergraph<C>,
-    panorama: &Panorama,
+    view: &StationView,
     detection: usize,
     landmark: LandmarkId,
     anchors: &[Sighting],
@@ -408,7 +424,7 @@ fn test_candidate<C: Calculus>(
         let (p, q) = (anchors[x], anchors[y]);
         match triple_consistency(
             map,
-            panorama,
+            view,
             [detection, p.position, q.position],
             [landmark, p.landmark, q.landmark],
         ) {
@@ -454,7 +470,7 @@ mod tests {
                 uncertainty: 0.01,
             })
             .collect();
-        let panorama = Panorama::new(bearings, RangeOrder::unordered(points.len())).unwrap();
+        let view = StationView::new(bearings, RangeOrder::unordered(points.len())).unwrap();
         let detections = points
             .iter()
             .map(|&p| Evidence {
@@ -463,13 +479,7 @@ mod tests {
                 placed: Some(at(p)),
             })
             .collect();
-        (
-            gallery,
-            StationEvidence {
-                panorama,
-                detections,
-            },
-        )
+        (gallery, StationEvidence { view, detections })
     }
 
     /// Associates the station against `frames` on an empty map with default settings.

@@ -79,8 +79,35 @@ pub fn register(
         .copied()
         .filter(|&(i, j)| seed(i, frame.landmarks[j].0))
         .collect();
-    // Hypotheses scored by how tightly they fit: Σ (1 − (d / tolerance)²) over their
-    // correspondences, so that a loose fit of many does not beat a tight fit of nearly as many.
+    let fit = best_motion(current, frame, &seeds, &correspondences)?;
+    if fit.inliers.len() < MIN_INLIERS || fit.score < fit.runner_up + MARGIN {
+        return None;
+    }
+    let (motion, pairs) = unambiguous(current, frame, &fit.inliers);
+    (pairs.len() >= MIN_INLIERS).then(|| Registration {
+        pairs,
+        motion: [motion.cos, motion.sin, motion.shift[0], motion.shift[1]],
+    })
+}
+
+/// The best motion hypothesis of [`best_motion`].
+struct Fit {
+    score: f64,
+    /// `(detection, index into the frame's landmarks)`.
+    inliers: Vec<(usize, usize)>,
+    /// Best score of a motion with a different assignment.
+    runner_up: f64,
+}
+
+/// The motion hypothesised from two seed correspondences that fits most correspondences.
+/// Hypotheses are scored by how tightly they fit: Σ (1 − (d / tolerance)²) over their
+/// correspondences, so that a loose fit of many does not beat a tight fit of nearly as many.
+fn best_motion(
+    current: &[Option<Placed>],
+    frame: &Frame,
+    seeds: &[(usize, usize)],
+    correspondences: &[(usize, usize)],
+) -> Option<Fit> {
     let mut best: Option<(f64, Vec<(usize, usize)>)> = None;
     let mut runner_up: f64 = 0.0;
     for (x, &(i1, j1)) in seeds.iter().enumerate() {
@@ -100,7 +127,7 @@ pub fn register(
                 continue;
             }
             let motion = Motion::from_pairs([p1.point, p2.point], [q1.point, q2.point]);
-            let (inliers, score) = matches(current, frame, &motion, &correspondences);
+            let (inliers, score) = matches(current, frame, &motion, correspondences);
             match &best {
                 Some((s, pairs)) if score <= *s => {
                     if !same_assignment(pairs, &inliers) {
@@ -118,15 +145,22 @@ pub fn register(
             }
         }
     }
-    let (score, pairs) = best?;
-    let count = pairs.len();
-    if count < MIN_INLIERS || score < runner_up + MARGIN {
-        return None;
-    }
-    // Refit on all inliers, then keep only the correspondences the motion makes unambiguous:
-    // every other landmark of the frame, and every other detection, lies clearly farther.
+    best.map(|(score, inliers)| Fit {
+        score,
+        inliers,
+        runner_up,
+    })
+}
+
+/// The motion refitted on all `inliers`, and the correspondences it makes unambiguous: every
+/// other landmark of the frame, and every other detection, lies clearly farther.
+fn unambiguous(
+    current: &[Option<Placed>],
+    frame: &Frame,
+    inliers: &[(usize, usize)],
+) -> (Motion, Vec<(usize, LandmarkId)>) {
     let motion = Motion::fit(
-        &pairs
+        &inliers
             .iter()
             .map(|&(i, j)| {
                 (
@@ -145,8 +179,9 @@ pub fn register(
     let placed: Vec<usize> = (0..current.len())
         .filter(|&i| current[i].is_some())
         .collect();
-    let pairs: Vec<(usize, LandmarkId)> = pairs
-        .into_iter()
+    let pairs = inliers
+        .iter()
+        .copied()
         .filter(|&(i, j)| {
             let d = gap(i, j);
             let (p, q) = (current[i].expect("placed"), frame.landmarks[j].1);
@@ -158,10 +193,7 @@ pub fn register(
         })
         .map(|(i, j)| (i, frame.landmarks[j].0))
         .collect();
-    (pairs.len() >= MIN_INLIERS).then(|| Registration {
-        pairs,
-        motion: [motion.cos, motion.sin, motion.shift[0], motion.shift[1]],
-    })
+    (motion, pairs)
 }
 
 impl Registration {

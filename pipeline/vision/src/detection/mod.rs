@@ -170,15 +170,9 @@ pub fn detect(
         fraction: settings.split_depth_fraction,
         min_columns: 3,
     };
-    let luminance = |img: &image::RgbImage| -> Vec<u16> {
-        img.as_raw()[top * w * 3..]
-            .chunks_exact(3)
-            .map(|p| u16::from(p[0]) + u16::from(p[1]) + u16::from(p[2]))
-            .collect()
-    };
     let bands = right
         .filter(|r| r.dimensions() == image.dimensions() && calib.stereo.baseline_m > 0.0)
-        .map(|r| (luminance(image), luminance(r)));
+        .map(|r| (ground_luminance(image, top), ground_luminance(r, top)));
     // The right camera sees a point turned towards increasing azimuth.
     let partner = bands.as_ref().map(|(own, other)| parallax::Partner {
         own,
@@ -189,26 +183,13 @@ pub fn detect(
         column_width: calib.column_width(),
         baseline_m: calib.stereo.baseline_m,
     });
-    // The search reaches the shift of a rock somewhat nearer than the blob's lowest row reads
-    // on flat ground (a rock's face overhangs its foot); a blob cut off by the image's bottom
-    // may hold a rock nearer still.
-    let max_shift = |pixels: &components::Component| -> usize {
-        let bottom = pixels.iter().map(|p| p.1 as usize).max().unwrap_or(0);
-        let margin = if bottom + 1 >= rows { 0.5 } else { 0.8 };
-        let nearest = calib
-            .ground_range((bottom + top + 1) as f64)
-            .map(|r| (margin * r).max(0.5));
-        nearest.map_or(0, |range| {
-            (calib.stereo_disparity(range) / calib.column_width()).ceil() as usize + 3
-        })
-    };
     let mut detections: Vec<Detection> = label_wrapped(&mask, w, rows)
         .into_iter()
         .enumerate()
         .flat_map(|(blob, c)| {
             let layers = match &partner {
                 Some(partner) => {
-                    let shift = max_shift(&c);
+                    let shift = max_shift(&c, top, rows, calib);
                     parallax::layers(c, partner, shift, settings.parallax)
                 }
                 None => vec![parallax::Layer {
@@ -219,19 +200,10 @@ pub fn detect(
             layers.into_iter().map(move |layer| (blob as u32, layer))
         })
         .flat_map(|(blob, layer)| {
-            // A farther layer's bottom edge is the nearer rock's outline, notched where that
-            // outline rises: the notch rule would cut the farther rock in two.
-            let pieces = if layer.part == Separation::Farther {
-                vec![split::Piece {
-                    pixels: layer.pixels,
-                    ambiguous: true,
-                }]
-            } else {
-                split::split(layer.pixels, rule)
-            };
-            pieces
+            let part = layer.part;
+            pieces(layer, rule)
                 .into_iter()
-                .map(move |piece| (blob, piece, layer.part))
+                .map(move |piece| (blob, piece, part))
         })
         .filter_map(|(blob, piece, part)| {
             let pixels = blob_of(&piece.pixels, w, &sample);
@@ -243,6 +215,48 @@ pub fn detect(
         .collect();
     detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
     detections
+}
+
+/// Per-pixel R+G+B below the horizon row `top`, for stereo block matching.
+fn ground_luminance(image: &image::RgbImage, top: usize) -> Vec<u16> {
+    image.as_raw()[top * image.width() as usize * 3..]
+        .chunks_exact(3)
+        .map(|p| u16::from(p[0]) + u16::from(p[1]) + u16::from(p[2]))
+        .collect()
+}
+
+/// The largest stereo shift (columns) to search for a blob: the shift of a rock somewhat
+/// nearer than the blob's lowest row reads on flat ground (a rock's face overhangs its foot);
+/// a blob cut off by the image's bottom may hold a rock nearer still. `top` is the horizon
+/// row, `rows` the rows below it.
+fn max_shift(
+    pixels: &components::Component,
+    top: usize,
+    rows: usize,
+    calib: &Calibration,
+) -> usize {
+    let bottom = pixels.iter().map(|p| p.1 as usize).max().unwrap_or(0);
+    let margin = if bottom + 1 >= rows { 0.5 } else { 0.8 };
+    let nearest = calib
+        .ground_range((bottom + top + 1) as f64)
+        .map(|r| (margin * r).max(0.5));
+    nearest.map_or(0, |range| {
+        (calib.stereo_disparity(range) / calib.column_width()).ceil() as usize + 3
+    })
+}
+
+/// The pieces of one parallax layer: touching rocks cut at notches of the bottom edge. A
+/// farther layer is not cut: its bottom edge is the nearer rock's outline, notched where that
+/// outline rises, and the notch rule would cut the farther rock in two.
+fn pieces(layer: parallax::Layer, rule: split::SplitRule) -> Vec<split::Piece> {
+    if layer.part == Separation::Farther {
+        vec![split::Piece {
+            pixels: layer.pixels,
+            ambiguous: true,
+        }]
+    } else {
+        split::split(layer.pixels, rule)
+    }
 }
 
 /// What a blob accumulates of each of its pixels for its appearance.

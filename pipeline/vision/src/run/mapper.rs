@@ -12,7 +12,7 @@ use crate::detection::{Detection, Separation};
 use crate::ranging::{self, PrimaryEye, Ranged, SensorModel};
 use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
-use qrm_core::measurement::Panorama;
+use qrm_core::measurement::StationView;
 use qrm_core::neighborhood::estimate;
 use std::time::Instant;
 
@@ -41,8 +41,8 @@ pub struct LandmarkRecord {
 #[derive(Clone, Debug, PartialEq)]
 struct HeldBack {
     station: usize,
-    panorama: Panorama,
-    /// Position in `panorama`, and index among the station's detections.
+    view: StationView,
+    /// Position in `view`, and index among the station's detections.
     detection: usize,
     primary_index: usize,
     candidates: Vec<LandmarkId>,
@@ -161,9 +161,9 @@ impl<C: Calculus> Mapper<C> {
         for (i, r) in ranged.iter().enumerate() {
             record.detections[i].range = detection_record(&station.primary[i], r).range;
         }
-        let panorama = selection::panorama_of(&ranged, &associated.usable);
-        record.order = asserted_order(&panorama, &associated.usable);
-        self.fuse_station(&mut record, associated, panorama);
+        let view = selection::view_of(&ranged, &associated.usable);
+        record.order = asserted_order(&view, &associated.usable);
+        self.fuse_station(&mut record, associated, view);
         record.fusion.resolved_held_back = self.retry_held_back(&mut record);
         record.seconds.map = start.elapsed().as_secs_f64();
         record.metrics = self.metrics();
@@ -195,12 +195,12 @@ impl<C: Calculus> Mapper<C> {
         &mut self,
         record: &mut StationRecord,
         associated: Associated,
-        panorama: Panorama,
+        view: StationView,
     ) {
         // With fewer than three landmarks there is no triple to measure, but the sightings
         // still place and describe the landmarks for association at later stations.
         let batch = if associated.fused.len() >= 3 {
-            self.map.observations(&panorama, &associated.fused)
+            self.map.observations(&view, &associated.fused)
         } else {
             Vec::new()
         };
@@ -211,7 +211,7 @@ impl<C: Calculus> Mapper<C> {
                 record.fusion.relations_tightened = report.relations_tightened;
                 self.next_landmark = associated.next_landmark;
                 self.remember(record, &associated);
-                self.hold_back(record, associated, panorama);
+                self.hold_back(record, associated, view);
             }
             Err(contradiction) => {
                 record.fusion.contradiction = Some(contradiction.to_string());
@@ -261,12 +261,7 @@ impl<C: Calculus> Mapper<C> {
     }
 
     /// Keeps the station's undecided detections to be tried again on a tighter map.
-    fn hold_back(
-        &mut self,
-        record: &mut StationRecord,
-        associated: Associated,
-        panorama: Panorama,
-    ) {
+    fn hold_back(&mut self, record: &mut StationRecord, associated: Associated, view: StationView) {
         for (position, candidates) in associated.held {
             let primary_index = associated.usable[position];
             record.detections[primary_index].association = Association::HeldBack {
@@ -274,7 +269,7 @@ impl<C: Calculus> Mapper<C> {
             };
             self.held.push(HeldBack {
                 station: record.index,
-                panorama: panorama.clone(),
+                view: view.clone(),
                 detection: position,
                 primary_index,
                 candidates,
@@ -300,7 +295,7 @@ impl<C: Calculus> Mapper<C> {
             let item = &pending[k];
             let standing = reconsider(
                 &self.map,
-                &item.panorama,
+                &item.view,
                 item.detection,
                 &item.candidates,
                 &item.decided,
@@ -322,7 +317,7 @@ impl<C: Calculus> Mapper<C> {
             }
             let landmark = self.next_landmark;
             let batch = self.map.observations_of(
-                &item.panorama,
+                &item.view,
                 Sighting::new(item.detection, landmark),
                 &item.decided,
             );
@@ -463,10 +458,10 @@ impl Associated {
 
 /// The asserted "nearer than" pairs of the panorama, as indices into the station's primary
 /// detections.
-fn asserted_order(panorama: &Panorama, usable: &[usize]) -> Vec<(usize, usize)> {
+fn asserted_order(view: &StationView, usable: &[usize]) -> Vec<(usize, usize)> {
     (0..usable.len())
         .flat_map(|a| (0..usable.len()).map(move |b| (a, b)))
-        .filter(|&(a, b)| panorama.order.is_nearer(a, b))
+        .filter(|&(a, b)| view.order.is_nearer(a, b))
         .map(|(a, b)| (usable[a], usable[b]))
         .collect()
 }

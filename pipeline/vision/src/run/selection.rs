@@ -5,9 +5,9 @@ use super::mapper::StationDetections;
 use crate::association::{Evidence, Placed, StationEvidence};
 use crate::detection::{Detection, Separation};
 use crate::ranging::{self, RangeInterval, Ranged, SensorModel};
-use qrm_core::measurement::{Bearing, Panorama, RangeOrder, MAX_BEARING_UNCERTAINTY};
+use qrm_core::measurement::{Bearing, RangeOrder, StationView, MAX_BEARING_UNCERTAINTY};
 
-/// Narrowest usable detection, columns (at least a 512th of the panorama): slivers are mostly
+/// Narrowest usable detection, columns (at least a 512th of the view): slivers are mostly
 /// pieces of larger rocks, whose centroids say little about where the rock is.
 const MIN_COLUMNS: u32 = 3;
 
@@ -40,7 +40,7 @@ fn stacked(d: &Detection) -> bool {
     height > MAX_ASPECT * width
 }
 
-/// The station as association sees it: the panorama of the `usable` detections, and the
+/// The station as association sees it: the view of the `usable` detections, and the
 /// evidence of each.
 pub(super) fn station_evidence(
     station: &StationDetections,
@@ -49,7 +49,7 @@ pub(super) fn station_evidence(
     model: &SensorModel,
 ) -> StationEvidence {
     StationEvidence {
-        panorama: panorama_of(ranged, usable),
+        view: view_of(ranged, usable),
         detections: usable
             .iter()
             .map(|&i| Evidence {
@@ -85,11 +85,11 @@ fn placed(r: &Ranged) -> Option<Placed> {
     })
 }
 
-/// The panorama of the detections at `usable` (bearings and the range order among them).
-pub(super) fn panorama_of(ranged: &[Ranged], usable: &[usize]) -> Panorama {
+/// The view of the detections at `usable` (bearings and the range order among them).
+pub(super) fn view_of(ranged: &[Ranged], usable: &[usize]) -> StationView {
     let chosen: Vec<Ranged> = usable.iter().map(|&i| ranged[i]).collect();
     let bearings: Vec<Bearing> = chosen.iter().map(|r| r.bearing).collect();
     let order: RangeOrder = ranging::range_order(&chosen);
-    Panorama::new(bearings, order)
+    StationView::new(bearings, order)
         .expect("bearings are finite, in range, with uncertainty below the limit")
 }
