@@ -143,15 +143,7 @@ pub fn detect(
     }
     let raw = &image.as_raw()[top * w * 3..];
     let background = row_medians(raw, w);
-    let mut mask = segment(raw, &background, w, settings);
-    close3(&mut mask, w);
-    let Ok(mask) = Image::<u8, 1>::new(
-        ImageSize {
-            width: w,
-            height: rows,
-        },
-        mask,
-    ) else {
+    let Some(mask) = rock_mask(raw, &background, w, rows, settings) else {
         return Vec::new();
     };
     let sample = |col: usize, row: usize| {
@@ -215,6 +207,26 @@ pub fn detect(
         .collect();
     detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
     detections
+}
+
+/// The closed mask of rock pixels of the ground rows `raw` (`rows` × `w`, RGB).
+fn rock_mask(
+    raw: &[u8],
+    background: &[(f32, f32)],
+    w: usize,
+    rows: usize,
+    settings: &DetectorSettings,
+) -> Option<Image<u8, 1>> {
+    let mut mask = segment(raw, background, w, settings);
+    close3(&mut mask, w);
+    Image::<u8, 1>::new(
+        ImageSize {
+            width: w,
+            height: rows,
+        },
+        mask,
+    )
+    .ok()
 }
 
 /// Per-pixel R+G+B below the horizon row `top`, for stereo block matching.
