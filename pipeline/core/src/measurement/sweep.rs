@@ -44,6 +44,15 @@ const VERTICES: [(f64, f64); 11] = [
 /// Relative size below which a boundary value counts as zero when classifying a sample.
 const ZERO_TOLERANCE: f64 = 1e-9;
 
+/// Coefficients of a critical-value polynomial within this fraction of its largest coefficient
+/// are rounding noise of an exact cancellation (e.g. `|u_B|² − |u_C|²` for two unit vectors,
+/// one ulp from 0 at most bearings and exactly 0 at a few): taken at face value they put a
+/// critical range near 0 or beyond 10¹⁴, whose gap is sampled where one landmark vanishes in
+/// rounding and every neighbouring region is classified in. A genuine coefficient this small
+/// would mean bearings within ~10⁻¹⁴ rad of a degenerate case, below what f64 angles resolve;
+/// the sweep does not distinguish range ratios beyond that (docs/MEASUREMENT.md).
+const COEFFICIENT_NOISE: f64 = 64.0 * f64::EPSILON;
+
 /// The EDC regions of `AB:C` reachable when A, B, C lie on the rays `u` (unit vectors, camera
 /// at the origin) with ranges ordered by `nearer` (`(p, q)`: landmark `p` of `[A, B, C]` is
 /// nearer than `q`; transitively closed), among `wanted` (the sweep stops once all are found).
@@ -191,7 +200,15 @@ fn push_roots(out: &mut Vec<f64>, a: f64, b: f64, c: f64) {
     if scale == 0.0 || !scale.is_finite() {
         return;
     }
-    let (a, b, c) = (a / scale, b / scale, c / scale);
+    let denoise = |x: f64| {
+        let x = x / scale;
+        if x.abs() <= COEFFICIENT_NOISE {
+            0.0
+        } else {
+            x
+        }
+    };
+    let (a, b, c) = (denoise(a), denoise(b), denoise(c));
     if a == 0.0 {
         if b != 0.0 {
             out.push(-c / b);

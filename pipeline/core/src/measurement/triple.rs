@@ -39,6 +39,13 @@ pub fn measure_triple_edc(
     if all_collinear(&bearings) {
         return None;
     }
+    // The relations do not depend on where the bearings' zero is; measuring in A's frame makes
+    // the result depend on the bearings' differences only, so that turning the rover (or the
+    // calibration's zero column) cannot change what is measured.
+    let bearings = bearings.map(|b| Bearing {
+        angle: b.angle - bearings[0].angle,
+        ..b
+    });
     let tables = edc::Edc::tables();
     let candidates = [
         candidates[0]
