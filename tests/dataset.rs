@@ -4,6 +4,7 @@
 //! format promises.
 
 use qrm_synth::dataset::{write_dataset, Counts, Preset, Request, Truth, VisibleRock};
+use qrm_synth::Encoding;
 use qrm_vision::calib::Calibration;
 
 fn calibration(scale: f64) -> Calibration {
@@ -28,6 +29,7 @@ fn render(preset: Preset, stations: usize, stereo: bool, name: &str) -> (Truth, 
                 stations: Some(stations),
             },
             stereo,
+            encoding: Encoding::default(),
         },
         &|| {},
     )
@@ -137,6 +139,7 @@ fn committed_demo_dataset_is_reproduced_byte_for_byte() {
                 stations: Some(16),
             },
             stereo: true,
+            encoding: Encoding::default(),
         },
         &|| {},
     )
@@ -151,5 +154,63 @@ fn committed_demo_dataset_is_reproduced_byte_for_byte() {
             fresh == old,
             "datasets/demo/{file} differs from a fresh render"
         );
+    }
+}
+
+/// A grayscale JPEG dataset, as a monochrome navigation camera's archive would hold it: `.jpg`
+/// files named in `truth.json`, one 8-bit channel of the calibration's size, and the luminance
+/// of the colour render within JPEG's error.
+#[test]
+fn grayscale_jpeg_datasets_are_written_as_asked() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let calib = calibration(0.25);
+    let request = |encoding| Request {
+        preset: Preset::Random,
+        seed: 2,
+        counts: Counts {
+            rocks: None,
+            stations: Some(2),
+        },
+        stereo: false,
+        encoding,
+    };
+    let colour = write_dataset(
+        &dir.join("png"),
+        &calib,
+        request(Encoding::default()),
+        &|| {},
+    )
+    .unwrap();
+    let grey = Encoding {
+        grayscale: true,
+        jpeg_quality: Some(85),
+    };
+    let truth = write_dataset(&dir.join("jpg"), &calib, request(grey), &|| {}).unwrap();
+    assert_eq!(truth.images.len(), 2);
+    for (image, png) in truth.images.iter().zip(&colour.images) {
+        assert!(image.file.ends_with(".jpg"), "{}", image.file);
+        assert_eq!(
+            image.rocks, png.rocks,
+            "truth does not depend on the encoding"
+        );
+        let decoded = image::open(dir.join("jpg").join(&image.file)).unwrap();
+        assert_eq!(decoded.color(), image::ColorType::L8);
+        assert_eq!(
+            (decoded.width(), decoded.height()),
+            (calib.image.width, calib.image.height)
+        );
+        let luma = image::open(dir.join("png").join(&png.file))
+            .unwrap()
+            .into_luma8();
+        let decoded = decoded.into_luma8();
+        let mean_error = decoded
+            .as_raw()
+            .iter()
+            .zip(luma.as_raw())
+            .map(|(&a, &b)| f64::from(a.abs_diff(b)))
+            .sum::<f64>()
+            / luma.as_raw().len() as f64;
+        assert!(mean_error < 3.0, "mean error {mean_error}");
     }
 }

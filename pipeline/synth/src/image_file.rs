@@ -1,18 +1,64 @@
-//! Saving renders as PNG files and shrinking them for previews.
+//! Saving renders as image files, encoded as a camera and an archive would deliver them, and
+//! shrinking them for previews.
 
 use super::render::Render;
+use image::codecs::jpeg::JpegEncoder;
+use image::{ExtendedColorType, ImageEncoder};
+use std::io::BufWriter;
 use std::path::Path;
 
+/// How a dataset's panoramas are encoded: a navigation camera is often monochrome, and
+/// archives often hold JPEG.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Encoding {
+    /// 8-bit luminance instead of RGB (Rec. 709 weights, as `image` converts).
+    pub grayscale: bool,
+    /// JPEG at this quality (1–100) instead of PNG.
+    pub jpeg_quality: Option<u8>,
+}
+
+impl Encoding {
+    /// The file extension of this encoding.
+    pub fn extension(&self) -> &'static str {
+        if self.jpeg_quality.is_some() {
+            "jpg"
+        } else {
+            "png"
+        }
+    }
+}
+
 impl Render {
-    /// Writes the colour image as an 8-bit RGB PNG.
-    pub fn save_png(&self, path: &Path) -> Result<(), image::ImageError> {
-        image::save_buffer(
-            path,
-            &self.rgb,
-            self.width,
-            self.height,
-            image::ExtendedColorType::Rgb8,
-        )
+    /// Writes the colour image with `encoding` (the extension of `path` is not consulted).
+    pub fn save(&self, path: &Path, encoding: Encoding) -> Result<(), image::ImageError> {
+        let rgb = image::RgbImage::from_raw(self.width, self.height, self.rgb.clone())
+            .expect("a render holds width × height RGB pixels");
+        let luma;
+        let (bytes, colour): (&[u8], ExtendedColorType) = if encoding.grayscale {
+            luma = image::DynamicImage::ImageRgb8(rgb.clone()).into_luma8();
+            (luma.as_raw(), ExtendedColorType::L8)
+        } else {
+            (rgb.as_raw(), ExtendedColorType::Rgb8)
+        };
+        match encoding.jpeg_quality {
+            Some(quality) => {
+                let file = BufWriter::new(std::fs::File::create(path)?);
+                JpegEncoder::new_with_quality(file, quality).write_image(
+                    bytes,
+                    self.width,
+                    self.height,
+                    colour,
+                )
+            }
+            None => image::save_buffer_with_format(
+                path,
+                bytes,
+                self.width,
+                self.height,
+                colour,
+                image::ImageFormat::Png,
+            ),
+        }
     }
 
     /// The image shrunk by an integer `factor` (box filter over whole blocks; a partial block at

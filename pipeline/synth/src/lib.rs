@@ -23,6 +23,7 @@ mod shade;
 mod shadow;
 mod world;
 
+pub use image_file::Encoding;
 pub use render::{optical_centre, render, Eye, Pose, Render};
 pub use world::{Lump, Rock, World};
 

@@ -164,7 +164,9 @@ fn bench_render(preview: Option<&std::path::Path>) {
         times.push(start.elapsed().as_secs_f64());
         if i == 0 {
             if let Some(path) = preview {
-                left.downscale(4).save_png(path).expect("preview written");
+                left.downscale(4)
+                    .save(path, qrm_synth::Encoding::default())
+                    .expect("preview written");
             }
             std::hint::black_box(right);
         }

@@ -5,7 +5,7 @@ use clap::Args;
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 use qrm_synth::dataset::{write_dataset, Counts, Preset, Request};
-use qrm_synth::default_calibration;
+use qrm_synth::{default_calibration, Encoding};
 use qrm_vision::calib::Calibration;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -55,6 +55,12 @@ pub struct SynthArgs {
     /// Scale the image size (and the focal length with it), e.g. 0.25 for a quick 1024 × 192 set.
     #[arg(long, default_value_t = 1.0)]
     scale: f64,
+    /// Write 8-bit grayscale panoramas, as a monochrome navigation camera would.
+    #[arg(long)]
+    grayscale: bool,
+    /// Write JPEG panoramas (`.jpg`) at this quality, 1–100, instead of PNG.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
+    jpeg: Option<u8>,
 }
 
 pub fn run(args: SynthArgs) -> Result<()> {
@@ -83,6 +89,10 @@ pub fn run(args: SynthArgs) -> Result<()> {
             stations: args.stations,
         },
         stereo: !args.mono,
+        encoding: Encoding {
+            grayscale: args.grayscale,
+            jpeg_quality: args.jpeg,
+        },
     };
     let stations = preset.layout(args.seed, request.counts).stations.len();
     let bar = ProgressBar::new(stations as u64);

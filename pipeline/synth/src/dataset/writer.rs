@@ -3,7 +3,7 @@
 
 use super::layout::{Counts, Layout, Preset};
 use super::truth::{visible_rocks, ImageTruth, RockTruth, StationTruth, Truth, FORMAT, VERSION};
-use crate::{render, Eye, Render, World};
+use crate::{render, Encoding, Eye, Render, World};
 use qrm_vision::calib::Calibration;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -31,6 +31,7 @@ pub struct Request {
     pub counts: Counts,
     /// A left and a right panorama per station, or one mono panorama.
     pub stereo: bool,
+    pub encoding: Encoding,
 }
 
 /// Renders `request` with `calib` into `dir`; `tick` is called after each station.
@@ -62,12 +63,13 @@ pub fn write_dataset(
                 .iter()
                 .map(|&(eye, label)| {
                     let image = render(&world, calib, pose, eye);
+                    let extension = request.encoding.extension();
                     let file = if request.stereo {
-                        format!("{}_{label}.png", names[i])
+                        format!("{}_{label}.{extension}", names[i])
                     } else {
-                        format!("{}.png", names[i])
+                        format!("{}.{extension}", names[i])
                     };
-                    write_png(&dir.join(&file), &image)?;
+                    write_image(&dir.join(&file), &image, request.encoding)?;
                     Ok(ImageTruth {
                         file,
                         station: i,
@@ -112,12 +114,12 @@ fn write_file(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
     })
 }
 
-fn write_png(path: &Path, image: &Render) -> Result<(), DatasetError> {
+fn write_image(path: &Path, image: &Render, encoding: Encoding) -> Result<(), DatasetError> {
     qrm_atomic_file::write_via_temporary(
         path,
         |temporary| {
             image
-                .save_png(temporary)
+                .save(temporary, encoding)
                 .map_err(|source| DatasetError::Encode {
                     path: path.to_path_buf(),
                     source,
