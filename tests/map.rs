@@ -521,3 +521,29 @@ fn malformed_json_is_rejected_with_a_reason() {
     let map = Hypergraph::<Edc>::from_json(&ok).unwrap();
     assert_eq!(map.relation(2, 3, 1), Some(RelationSet::single(17)));
 }
+
+/// A map restricted to some landmarks holds exactly their relations as the whole map does
+/// (a restriction of a path-consistent network is path consistent: nothing tightens).
+#[test]
+fn restriction_keeps_the_relations_among_the_kept_landmarks() {
+    let mut rng = rng(41);
+    let points = scene(&mut rng, 9);
+    let mut map = Hypergraph::<Edc>::new();
+    for batch in batches::<Edc>(&mut rng, &points, 6, 40, 3) {
+        map.fuse(&batch)
+            .expect("sound observations never contradict");
+    }
+    let keep = |l: u32| l % 3 != 1;
+    let part = map.restricted(keep);
+    assert!(part.landmarks().iter().all(|&l| keep(l)));
+    let mut compared = 0;
+    for (a, b, c, relations) in map.triples() {
+        if keep(a) && keep(b) && keep(c) {
+            assert_eq!(part.relation(a, b, c), Some(relations[0]));
+            assert_eq!(part.relation(b, c, a), Some(relations[1]));
+            compared += 1;
+        }
+    }
+    assert_eq!(compared, part.triple_count());
+    assert!(compared > 0);
+}

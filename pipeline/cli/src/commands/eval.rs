@@ -150,10 +150,12 @@ fn print_report(e: &Evaluation) {
             );
         }
     }
-    if let Some(rng) = &e.map.rng {
-        println!(
-            "  RNG: precision {:.2}, recall {:.2}, {} true edges pruned",
-            rng.precision, rng.recall, rng.true_edges_pruned
-        );
+    for (name, rng) in [("run", &e.map.rng), ("exact", &e.map.rng_exact)] {
+        if let Some(rng) = rng {
+            println!(
+                "  RNG ({name:<5}): precision {:.2}, recall {:.2}, {} true edges pruned, over the {} one-rock landmarks",
+                rng.precision, rng.recall, rng.true_edges_pruned, rng.landmarks
+            );
+        }
     }
 }

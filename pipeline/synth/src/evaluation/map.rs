@@ -33,20 +33,25 @@ pub(super) fn score(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> Map
         Edc::classify(position(a)?, position(b)?, position(c)?)
     };
     let exact = exact_map(run, truth, rocks);
+    let rng = |map: &Hypergraph<Edc>| {
+        let map = map.restricted(defined);
+        if map.len() < 3 {
+            return None;
+        }
+        let estimate = estimate(&map)?;
+        let comparison = compare(&map, &estimate, |l| position(l).expect("restricted"));
+        Some(RngScore {
+            landmarks: map.len(),
+            precision: comparison.precision(),
+            recall: comparison.recall(),
+            true_edges_pruned: comparison.pruned_true,
+        })
+    };
     MapScore {
         run: map_score(run.map, &majority_truth, &defined),
         exact: map_score(&exact, &defined_truth, &defined),
-        rng: estimate(run.map).and_then(|rng| {
-            if run.map.landmarks().iter().any(|&l| position(l).is_none()) {
-                return None;
-            }
-            let comparison = compare(run.map, &rng, |l| position(l).expect("checked"));
-            Some(RngScore {
-                precision: comparison.precision(),
-                recall: comparison.recall(),
-                true_edges_pruned: comparison.pruned_true,
-            })
-        }),
+        rng: rng(run.map),
+        rng_exact: rng(&exact),
     }
 }
 

@@ -100,7 +100,11 @@ pub struct AssociationScore {
 pub struct MapScore {
     pub run: MapMetricsScore,
     pub exact: MapMetricsScore,
+    /// The RNG estimate (000 §VII-A) of the run's map and of the exact map, each restricted to
+    /// the landmarks that stand for one rock each, against the true RNG of those rocks. `None`
+    /// with fewer than three such landmarks.
     pub rng: Option<RngScore>,
+    pub rng_exact: Option<RngScore>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -124,6 +128,8 @@ pub struct MapMetricsScore {
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct RngScore {
+    /// Landmarks compared: those that stand for one rock each (the map restricted to them).
+    pub landmarks: usize,
     pub precision: f64,
     pub recall: f64,
     pub true_edges_pruned: usize,
