@@ -4,7 +4,7 @@
 //! format promises.
 
 use qrm_synth::dataset::{write_dataset, Counts, Preset, Request, Truth, VisibleRock};
-use qrm_synth::Encoding;
+use qrm_synth::{Capture, Encoding};
 use qrm_vision::calib::Calibration;
 
 fn calibration(scale: f64) -> Calibration {
@@ -29,6 +29,7 @@ fn render(preset: Preset, stations: usize, stereo: bool, name: &str) -> (Truth, 
                 stations: Some(stations),
             },
             stereo,
+            capture: Capture::default(),
             encoding: Encoding::default(),
         },
         &|| {},
@@ -139,6 +140,7 @@ fn committed_demo_dataset_is_reproduced_byte_for_byte() {
                 stations: Some(16),
             },
             stereo: true,
+            capture: Capture::default(),
             encoding: Encoding::default(),
         },
         &|| {},
@@ -173,6 +175,7 @@ fn grayscale_jpeg_datasets_are_written_as_asked() {
             stations: Some(2),
         },
         stereo: false,
+        capture: Capture::default(),
         encoding,
     };
     let colour = write_dataset(

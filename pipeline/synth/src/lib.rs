@@ -14,6 +14,7 @@
 pub mod dataset;
 pub mod evaluation;
 
+mod capture;
 mod ellipsoid;
 mod image_file;
 mod noise;
@@ -23,6 +24,7 @@ mod shade;
 mod shadow;
 mod world;
 
+pub use capture::Capture;
 pub use image_file::Encoding;
 pub use render::{optical_centre, render, Eye, Pose, Render};
 pub use world::{Lump, Rock, World};

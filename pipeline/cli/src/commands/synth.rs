@@ -5,7 +5,7 @@ use clap::Args;
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 use qrm_synth::dataset::{write_dataset, Counts, Preset, Request};
-use qrm_synth::{default_calibration, Encoding};
+use qrm_synth::{default_calibration, Capture, Encoding};
 use qrm_vision::calib::Calibration;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -55,6 +55,22 @@ pub struct SynthArgs {
     /// Scale the image size (and the focal length with it), e.g. 0.25 for a quick 1024 × 192 set.
     #[arg(long, default_value_t = 1.0)]
     scale: f64,
+    /// Exposure change in stops (e.g. -1 for an image half as bright), clipped at white.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    exposure: f64,
+    /// Tone curve: channel values v in [0, 1] become v^(1/GAMMA) (1 = linear, 2.2 = sRGB-like).
+    #[arg(long, default_value_t = 1.0)]
+    gamma: f64,
+    /// Light lost at the top and bottom edges, falling off quadratically from the middle row
+    /// (0 = none, 0.3 = 30 % darker edges).
+    #[arg(long, default_value_t = 0.0)]
+    vignetting: f64,
+    /// Gaussian blur, standard deviation in pixels (0 = sharp).
+    #[arg(long, default_value_t = 0.0)]
+    blur: f32,
+    /// Additive Gaussian sensor noise, standard deviation in 8-bit levels (0 = none).
+    #[arg(long, default_value_t = 0.0)]
+    noise: f64,
     /// Write 8-bit grayscale panoramas, as a monochrome navigation camera would.
     #[arg(long)]
     grayscale: bool,
@@ -81,6 +97,7 @@ pub fn run(args: SynthArgs) -> Result<()> {
     if args.rocks.is_some_and(|n| n > 2000) {
         bail!("--rocks must be at most 2000");
     }
+    let capture = capture(&args)?;
     let request = Request {
         preset,
         seed: args.seed,
@@ -89,6 +106,7 @@ pub fn run(args: SynthArgs) -> Result<()> {
             stations: args.stations,
         },
         stereo: !args.mono,
+        capture,
         encoding: Encoding {
             grayscale: args.grayscale,
             jpeg_quality: args.jpeg,
@@ -120,4 +138,27 @@ pub fn run(args: SynthArgs) -> Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// The camera effects asked for, each checked against a range a camera can produce.
+fn capture(args: &SynthArgs) -> Result<Capture> {
+    let checks = [
+        ("--exposure", args.exposure, -8.0, 8.0),
+        ("--gamma", args.gamma, 0.2, 5.0),
+        ("--vignetting", args.vignetting, 0.0, 0.9),
+        ("--blur", f64::from(args.blur), 0.0, 20.0),
+        ("--noise", args.noise, 0.0, 64.0),
+    ];
+    for (flag, value, low, high) in checks {
+        if !(low..=high).contains(&value) {
+            bail!("{flag} {value} must lie in [{low}, {high}]");
+        }
+    }
+    Ok(Capture {
+        exposure_ev: args.exposure,
+        gamma: args.gamma,
+        vignetting: args.vignetting,
+        blur_px: args.blur,
+        noise: args.noise,
+    })
 }

@@ -3,7 +3,7 @@
 
 use super::layout::{Counts, Layout, Preset};
 use super::truth::{visible_rocks, ImageTruth, RockTruth, StationTruth, Truth, FORMAT, VERSION};
-use crate::{render, Encoding, Eye, Render, World};
+use crate::{render, Capture, Encoding, Eye, Render, World};
 use qrm_vision::calib::Calibration;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -31,6 +31,8 @@ pub struct Request {
     pub counts: Counts,
     /// A left and a right panorama per station, or one mono panorama.
     pub stereo: bool,
+    /// Camera effects on every image (noise drawn per image from the seed).
+    pub capture: Capture,
     pub encoding: Encoding,
 }
 
@@ -61,15 +63,18 @@ pub fn write_dataset(
         .map(|(i, &pose)| {
             let images = eyes
                 .iter()
-                .map(|&(eye, label)| {
+                .enumerate()
+                .map(|(k, &(eye, label))| {
                     let image = render(&world, calib, pose, eye);
+                    let image_seed = request.seed ^ ((i * eyes.len() + k) as u64).rotate_left(32);
+                    let recorded = request.capture.apply(&image, image_seed);
                     let extension = request.encoding.extension();
                     let file = if request.stereo {
                         format!("{}_{label}.{extension}", names[i])
                     } else {
                         format!("{}.{extension}", names[i])
                     };
-                    write_image(&dir.join(&file), &image, request.encoding)?;
+                    write_image(&dir.join(&file), &recorded, request.encoding)?;
                     Ok(ImageTruth {
                         file,
                         station: i,
