@@ -31,14 +31,16 @@ impl Encoding {
 impl Render {
     /// Writes the colour image with `encoding` (the extension of `path` is not consulted).
     pub fn save(&self, path: &Path, encoding: Encoding) -> Result<(), image::ImageError> {
-        let rgb = image::RgbImage::from_raw(self.width, self.height, self.rgb.clone())
-            .expect("a render holds width × height RGB pixels");
         let luma;
         let (bytes, colour): (&[u8], ExtendedColorType) = if encoding.grayscale {
-            luma = image::DynamicImage::ImageRgb8(rgb.clone()).into_luma8();
+            // `DynamicImage::into_luma8`'s conversion (Rec. 709 weights), on a copy: the
+            // colour path below writes the render's pixels as they are.
+            let rgb = image::RgbImage::from_raw(self.width, self.height, self.rgb.clone())
+                .expect("a render holds width × height RGB pixels");
+            luma = image::DynamicImage::ImageRgb8(rgb).into_luma8();
             (luma.as_raw(), ExtendedColorType::L8)
         } else {
-            (rgb.as_raw(), ExtendedColorType::Rgb8)
+            (&self.rgb, ExtendedColorType::Rgb8)
         };
         match encoding.jpeg_quality {
             Some(quality) => {

@@ -153,14 +153,7 @@ impl<C: Calculus> Hypergraph<C> {
             other.relation(relation[1], relation[2], relation[0]),
             other.relation(relation[2], relation[0], relation[1]),
         ) {
-            (Some(x), Some(y), Some(z)) => {
-                let [a, b, c] = relation;
-                vec![
-                    Observation::new(a, b, c, x),
-                    Observation::new(b, c, a, y),
-                    Observation::new(c, a, b, z),
-                ]
-            }
+            (Some(x), Some(y), Some(z)) => Observation::of_triple(relation, [x, y, z]).to_vec(),
             _ => Vec::new(),
         };
         Err(Contradiction {

@@ -62,13 +62,7 @@ impl<C: Calculus> Hypergraph<C> {
         let observations: Vec<Observation> = self
             .triples()
             .filter(|&(a, b, c, _)| keep(a) && keep(b) && keep(c))
-            .flat_map(|(a, b, c, r)| {
-                [
-                    Observation::new(a, b, c, r[0]),
-                    Observation::new(b, c, a, r[1]),
-                    Observation::new(c, a, b, r[2]),
-                ]
-            })
+            .flat_map(|(a, b, c, r)| Observation::of_triple([a, b, c], r))
             .collect();
         let mut map = Hypergraph::new();
         map.fuse(&observations)
@@ -83,16 +77,13 @@ impl<C: Calculus> Hypergraph<C> {
         triples
             .par_iter()
             .flat_map_iter(|triple| {
-                let [a, b, c] = triple.map(|s| s.landmark);
+                let ids = triple.map(|s| s.landmark);
+                let [a, b, c] = ids;
                 let states = view.measure_triple::<C>(
                     triple.map(|s| s.position),
                     [open(a, b, c), open(b, c, a), open(c, a, b)],
                 );
-                [
-                    Observation::new(a, b, c, states[0]),
-                    Observation::new(b, c, a, states[1]),
-                    Observation::new(c, a, b, states[2]),
-                ]
+                Observation::of_triple(ids, states)
             })
             .collect()
     }

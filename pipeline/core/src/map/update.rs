@@ -21,6 +21,15 @@ impl Observation {
         Observation { a, b, c, states }
     }
 
+    /// The relations `[AB:C, BC:A, CA:B]` of the triple `[a, b, c]` as three observations.
+    pub fn of_triple([a, b, c]: [LandmarkId; 3], states: [RelationSet; 3]) -> [Observation; 3] {
+        [
+            Observation::new(a, b, c, states[0]),
+            Observation::new(b, c, a, states[1]),
+            Observation::new(c, a, b, states[2]),
+        ]
+    }
+
     /// Whether the observation is about the three landmarks `ids`, in any order.
     pub fn is_about(&self, ids: [LandmarkId; 3]) -> bool {
         let mut mine = [self.a, self.b, self.c];

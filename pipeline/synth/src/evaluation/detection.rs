@@ -70,15 +70,29 @@ pub fn match_detections(
     rocks: &[VisibleRock],
     width: u32,
 ) -> Vec<Option<usize>> {
-    let mut best: Vec<Option<(usize, f64)>> = vec![None; rocks.len()];
-    for (i, d) in detections.iter().enumerate() {
-        if let Some((rock, distance)) = claim(d, rocks, width) {
+    credit(&claims(detections, rocks, width), rocks.len())
+}
+
+/// The rock each detection claims, with the distance between their centroids.
+fn claims(
+    detections: &[DetectedBox],
+    rocks: &[VisibleRock],
+    width: u32,
+) -> Vec<Option<(usize, f64)>> {
+    detections.iter().map(|d| claim(d, rocks, width)).collect()
+}
+
+/// Each claimed rock credited to its nearest claimant: the rock of each detection.
+fn credit(claims: &[Option<(usize, f64)>], rocks: usize) -> Vec<Option<usize>> {
+    let mut best: Vec<Option<(usize, f64)>> = vec![None; rocks];
+    for (i, claim) in claims.iter().enumerate() {
+        if let Some((rock, distance)) = *claim {
             if best[rock].is_none_or(|(_, nearest)| distance < nearest) {
                 best[rock] = Some((i, distance));
             }
         }
     }
-    let mut credited = vec![None; detections.len()];
+    let mut credited = vec![None; claims.len()];
     for (rock, claimant) in best.iter().enumerate() {
         if let Some((i, _)) = claimant {
             credited[*i] = Some(rock);
@@ -155,16 +169,16 @@ impl Score {
         detectable: Detectable,
     ) -> Vec<Option<usize>> {
         let width = calib.image.width;
-        let credited = match_detections(detections, rocks, width);
+        let claims = claims(detections, rocks, width);
+        let credited = credit(&claims, rocks.len());
         self.images += 1;
         self.detections += detections.len();
         self.true_detections += credited.iter().flatten().count();
-        for (d, rock) in detections.iter().zip(&credited) {
-            if rock.is_none() {
-                match claim(d, rocks, width) {
-                    Some(_) => self.splits += 1,
-                    None => self.false_alarms += 1,
-                }
+        for (claim, rock) in claims.iter().zip(&credited) {
+            match (claim, rock) {
+                (_, Some(_)) => {}
+                (Some(_), None) => self.splits += 1,
+                (None, None) => self.false_alarms += 1,
             }
         }
         for (k, rock) in rocks.iter().enumerate() {
