@@ -21,6 +21,10 @@ pub struct Placed {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     pub landmarks: Vec<(LandmarkId, Placed)>,
+    /// Whether the frame accumulates many stations' landmarks (the [`super::Sketch`]): it
+    /// holds more look-alikes near each landmark than one station sees, so leaving a landmark
+    /// unpaired is no evidence against a pair other frames make.
+    pub accumulated: bool,
 }
 
 impl Frame {
@@ -219,13 +223,21 @@ fn same_assignment(a: &[(usize, usize)], b: &[(usize, usize)]) -> bool {
 type PointPair = ([f64; 2], [f64; 2]);
 
 /// Rotation by `angle` then translation.
-struct Motion {
+pub(super) struct Motion {
     cos: f64,
     sin: f64,
     shift: [f64; 2],
 }
 
 impl Motion {
+    pub(super) fn identity() -> Motion {
+        Motion {
+            cos: 1.0,
+            sin: 0.0,
+            shift: [0.0, 0.0],
+        }
+    }
+
     /// The motion taking `p[0]` onto `q[0]` and the direction `p[0]→p[1]` onto `q[0]→q[1]`.
     fn from_pairs(p: [[f64; 2]; 2], q: [[f64; 2]; 2]) -> Motion {
         let angle = (q[1][1] - q[0][1]).atan2(q[1][0] - q[0][0])
@@ -240,7 +252,7 @@ impl Motion {
     }
 
     /// The least-squares rigid motion taking each `.0` onto its `.1` (2-D Procrustes).
-    fn fit(pairs: &[PointPair]) -> Motion {
+    pub(super) fn fit(pairs: &[PointPair]) -> Motion {
         let n = pairs.len() as f64;
         let mean = |f: fn(&PointPair) -> [f64; 2]| {
             let sum = pairs
@@ -266,7 +278,7 @@ impl Motion {
         }
     }
 
-    fn apply(&self, p: [f64; 2]) -> [f64; 2] {
+    pub(super) fn apply(&self, p: [f64; 2]) -> [f64; 2] {
         [
             self.cos * p[0] - self.sin * p[1] + self.shift[0],
             self.sin * p[0] + self.cos * p[1] + self.shift[1],
@@ -308,7 +320,7 @@ fn matches(
     (out, score)
 }
 
-fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
+pub(super) fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
@@ -331,6 +343,7 @@ pub(super) mod tests {
         let field = FIELD;
         let (angle, shift) = (0.7f64, [1.5, -0.8]);
         let frame = Frame {
+            accumulated: false,
             landmarks: field
                 .iter()
                 .enumerate()
@@ -374,6 +387,7 @@ pub(super) mod tests {
     #[test]
     fn too_few_correspondences_register_nothing() {
         let frame = Frame {
+            accumulated: false,
             landmarks: vec![(
                 1,
                 Placed {
