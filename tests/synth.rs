@@ -2,7 +2,7 @@
 //! rock's pixels fall (bearing, ground contact, stereo parallax), occlusion and determinism.
 
 use qrm_core::geometry::Point;
-use qrm_synth::{render, Eye, Lump, Pose, Render, World};
+use qrm_synth::{render, Eye, Lump, Pose, Render, Scenery, World};
 use qrm_vision::calib::Calibration;
 use std::f64::consts::TAU;
 
@@ -202,6 +202,92 @@ fn the_near_rock_hides_the_far_one() {
     assert!(
         hidden > 100,
         "the far rock is behind the near one ({hidden} pixels)"
+    );
+}
+
+/// Ground pixels (no rock in either image) that `with` shows at least 15 % darker than
+/// `without`, the same scene without its rocks: the rocks' cast shadows.
+fn shadow_pixels(with: &Render, without: &Render) -> usize {
+    let luminance = |r: &Render, i: usize| -> u32 {
+        r.rgb[3 * i..3 * i + 3].iter().map(|&v| u32::from(v)).sum()
+    };
+    (0..with.rock_id.len())
+        .filter(|&i| with.rock_id[i] == 0 && 100 * luminance(with, i) < 85 * luminance(without, i))
+        .count()
+}
+
+#[test]
+fn a_low_sun_casts_longer_shadows() {
+    let calib = calibration().scaled(0.25).unwrap();
+    let shadows = |elevation: f64| {
+        let mut world = balls(&placements());
+        Scenery {
+            sun_elevation_deg: Some(elevation),
+            ..Scenery::default()
+        }
+        .apply(&mut world);
+        let with = render(&world, &calib, POSE, Eye::Mono);
+        let without = render(&world.rocks_only(&[]), &calib, POSE, Eye::Mono);
+        shadow_pixels(&with, &without)
+    };
+    let (high, low) = (shadows(40.0), shadows(8.0));
+    // Shadows are h / tan(elevation) long: 6 times longer at 8° than at 40°; their pixels grow
+    // less, as the far end of a shadow is seen smaller.
+    assert!(high > 20 && low > 3 * high, "40°: {high} px, 8°: {low} px");
+}
+
+/// Mean colour (8-bit channels) of the pixels of `image` that `pick` selects.
+fn mean_colour(image: &Render, pick: impl Fn(usize) -> bool) -> [f64; 3] {
+    let mut sum = [0.0; 3];
+    let mut n = 0.0;
+    for i in (0..image.rock_id.len()).filter(|&i| pick(i)) {
+        for (total, &v) in sum.iter_mut().zip(&image.rgb[3 * i..3 * i + 3]) {
+            *total += f64::from(v);
+        }
+        n += 1.0;
+    }
+    sum.map(|total| total / n)
+}
+
+/// How far each rock's hue lies from the soil's around it, averaged over the rocks: the summed
+/// difference of the channels' shares of the mean colour. (Brightness is left out: lighting
+/// makes a rock's sunlit faces brighter than flat ground whatever its albedo; the albedo
+/// itself is checked in `qrm_synth`'s unit tests.)
+fn hue_contrast(image: &Render, calib: &Calibration, ids: &[u32]) -> f64 {
+    let width = image.width as usize;
+    let below = calib.elevation.horizon_row.ceil() as usize * width;
+    let shares = |c: [f64; 3]| c.map(|v| v / c.iter().sum::<f64>());
+    let mut hue = 0.0;
+    for &id in ids {
+        let columns: Vec<bool> = (0..width)
+            .map(|c| (0..image.height as usize).any(|r| image.rock_id[r * width + c] == id + 1))
+            .collect();
+        let rock = shares(mean_colour(image, |i| image.rock_id[i] == id + 1));
+        let soil = shares(mean_colour(image, |i| {
+            i >= below && image.rock_id[i] == 0 && columns[i % width]
+        }));
+        hue += (0..3).map(|k| (rock[k] - soil[k]).abs()).sum::<f64>();
+    }
+    hue / ids.len() as f64
+}
+
+#[test]
+fn albedo_contrast_brings_rock_colour_to_the_soil() {
+    let calib = calibration().scaled(0.25).unwrap();
+    let contrast = |k: f64| {
+        let mut world = World::generate(5, &placements());
+        Scenery {
+            rock_albedo_contrast: k,
+            ..Scenery::default()
+        }
+        .apply(&mut world);
+        let ids: Vec<u32> = world.rocks.iter().map(|r| r.id).collect();
+        hue_contrast(&render(&world, &calib, POSE, Eye::Mono), &calib, &ids)
+    };
+    let (drawn, half, soil_like) = (contrast(1.0), contrast(0.5), contrast(0.0));
+    assert!(
+        soil_like < 0.25 * drawn && half < 0.75 * drawn,
+        "hue contrast at 1: {drawn}, 0.5: {half}, 0: {soil_like}"
     );
 }
 

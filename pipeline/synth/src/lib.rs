@@ -20,6 +20,7 @@ mod image_file;
 mod noise;
 mod render;
 mod scene;
+mod scenery;
 mod shade;
 mod shadow;
 mod world;
@@ -27,6 +28,7 @@ mod world;
 pub use capture::Capture;
 pub use image_file::Encoding;
 pub use render::{optical_centre, render, Eye, Pose, Render};
+pub use scenery::Scenery;
 pub use world::{Lump, Rock, World};
 
 use qrm_vision::calib::Calibration;

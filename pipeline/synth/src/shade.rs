@@ -48,9 +48,7 @@ pub fn ground(seed: u64, x: f64, y: f64, footprint: f64, sun: [f64; 3]) -> (Rgb,
     let drift = fbm2(seed, x / 9.0, y / 9.0, 3, footprint / 9.0);
     let mottle = fbm2(seed ^ 1, x / 0.7, y / 0.7, 4, footprint / 0.7);
     let grain = fbm2(seed ^ 2, x / 0.05, y / 0.05, 2, footprint / 0.05);
-    let red: Rgb = [0.42, 0.19, 0.085];
-    let dusty: Rgb = [0.33, 0.20, 0.12];
-    let c = mix(red, dusty, (drift * 1.8 - 0.4).clamp(0.0, 1.0));
+    let c = soil_tint(drift);
     let brightness = 0.7 + 0.6 * drift + 0.45 * (mottle - 0.5) + 0.3 * (grain - 0.5);
     let c = scale(c, brightness);
     let up = [0.0, 0.0, 1.0];
@@ -70,6 +68,23 @@ pub fn ground(seed: u64, x: f64, y: f64, footprint: f64, sun: [f64; 3]) -> (Rgb,
         Pebble::Shadow => (c, up, false),
         Pebble::None => (c, up, true),
     }
+}
+
+/// The regolith's colour before brightness at `drift` (its broad light and dark patches, in
+/// [0, 1)): from red iron oxide to dusty brown.
+fn soil_tint(drift: f64) -> Rgb {
+    let red: Rgb = [0.42, 0.19, 0.085];
+    let dusty: Rgb = [0.33, 0.20, 0.12];
+    mix(red, dusty, (drift * 1.8 - 0.4).clamp(0.0, 1.0))
+}
+
+/// The regolith's mean reflectance around ground point (x, y): [`ground`]'s colour and
+/// brightness of the broad drift there, without the finer mottle, grain and pebbles, which
+/// average out over a rock-sized patch. A rock of this albedo is as bright and as red as the
+/// soil it lies on.
+pub fn soil(seed: u64, x: f64, y: f64) -> Rgb {
+    let drift = fbm2(seed, x / 9.0, y / 9.0, 3, 0.0);
+    scale(soil_tint(drift), 0.7 + 0.6 * drift)
 }
 
 /// Pebble spacing on the ground, metres (one candidate per cell of this size).
@@ -101,9 +116,21 @@ fn pebble(seed: u64, x: f64, y: f64, footprint: f64, sun: [f64; 3]) -> Pebble {
     let horizontal = sun[0].hypot(sun[1]).max(1e-12);
     let run = horizontal / sun[2].max(0.05);
     let toward = [sun[0] / horizontal, sun[1] / horizontal];
+    // Cells whose pebble can hold or shade this point: the 3 × 3 around it (a pebble is at most
+    // 0.4 cell across) and, under a low sun, those along the way to the sun as far as the
+    // longest pebble shadow reaches (length 0.6 · 0.4 · run, half-width 0.8 · 0.4 cells).
+    // Visited in the same order either way, so a high sun shades exactly as the 3 × 3 alone.
+    let length = 0.24 * run;
+    let reach = |k: usize, from: f64| {
+        let far = from + length * toward[k];
+        let low = (from.min(far) - 0.32).floor() as i64 - from.floor() as i64;
+        let high = (from.max(far) + 0.32).floor() as i64 - from.floor() as i64;
+        (low.min(-1), high.max(1))
+    };
+    let (u_cells, v_cells) = (reach(0, u), reach(1, v));
     let mut shaded = false;
-    for dv in -1..=1 {
-        for du in -1..=1 {
+    for dv in v_cells.0..=v_cells.1 {
+        for du in u_cells.0..=u_cells.1 {
             let cell = [cu + du, cv + dv, 0];
             if cell_value(seed, cell, 0) > 0.12 {
                 continue;
