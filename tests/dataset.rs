@@ -3,9 +3,10 @@
 //! with ranges, left/right disparity with range and baseline — and the files are what the
 //! format promises.
 
-use qrm_synth::dataset::{write_dataset, Counts, Preset, Request, Truth, VisibleRock};
-use qrm_synth::{Capture, Encoding};
-use qrm_vision::calib::Calibration;
+use qrm_synth::dataset::{write_dataset, Counts, Preset, Request, Truth, Variant, VisibleRock};
+use qrm_synth::{render as render_image, Capture, Encoding, Eye, Scenery, World};
+use qrm_vision::calib::{AzimuthAxis, Calibration, ColumnDirection};
+use std::f64::consts::TAU;
 
 fn calibration(scale: f64) -> Calibration {
     qrm_synth::default_calibration().scaled(scale).unwrap()
@@ -29,6 +30,7 @@ fn render(preset: Preset, stations: usize, stereo: bool, name: &str) -> (Truth, 
                 stations: Some(stations),
             },
             stereo,
+            scenery: Scenery::default(),
             capture: Capture::default(),
             encoding: Encoding::default(),
         },
@@ -59,6 +61,12 @@ fn column_difference(a: f64, b: f64, width: f64) -> f64 {
 #[test]
 fn centroids_follow_bearings_and_contacts_follow_ranges() {
     let (truth, calib) = render(Preset::Random, 4, false, "mono");
+    check_centroids_and_contacts(&truth, &calib);
+}
+
+/// Every well-seen rock's visible centroid lies at its true bearing's column, and its lowest
+/// visible row at its ground contact's row.
+fn check_centroids_and_contacts(truth: &Truth, calib: &Calibration) {
     let width = f64::from(calib.image.width);
     let mut checked = 0;
     for image in &truth.images {
@@ -89,6 +97,208 @@ fn centroids_follow_bearings_and_contacts_follow_ranges() {
         }
     }
     assert!(checked >= 10, "only {checked} rocks checked");
+}
+
+/// Under a counter-clockwise calibration with column 0 elsewhere, the truth's bearing columns
+/// are where the calibration's definition puts them (computed here by hand), and the rendered
+/// rock pixels are there.
+#[test]
+fn counter_clockwise_calibration_truth_matches_the_pixels() {
+    let scratch = tempfile::tempdir().unwrap();
+    let mut calib = calibration(0.5);
+    calib.azimuth = AzimuthAxis {
+        column0_deg: 37.0,
+        direction: ColumnDirection::CounterClockwise,
+    };
+    let truth = write_dataset(
+        scratch.path(),
+        &calib,
+        Request {
+            preset: Preset::Random,
+            seed: 4,
+            counts: Counts {
+                rocks: None,
+                stations: Some(4),
+            },
+            stereo: false,
+            scenery: Scenery::default(),
+            capture: Capture::default(),
+            encoding: Encoding::default(),
+        },
+        &|| {},
+    )
+    .unwrap();
+    assert_eq!(
+        Calibration::load(&scratch.path().join("calib.toml")).unwrap(),
+        calib
+    );
+    let width = f64::from(calib.image.width);
+    for image in &truth.images {
+        let station = &truth.stations[image.station];
+        for rock in &image.rocks {
+            // Azimuth grows with the column from 37° at column 0's left edge.
+            let [x, y] = truth.rocks[rock.id as usize].position;
+            let bearing = ((y - station.position[1]).atan2(x - station.position[0])
+                - station.heading)
+                .rem_euclid(TAU);
+            assert!((bearing - rock.bearing).abs() < 1e-9);
+            let by_hand = (bearing - 37f64.to_radians()).rem_euclid(TAU) / TAU * width;
+            assert!(
+                column_difference(rock.bearing_column, by_hand, width) < 1e-6,
+                "rock {}: {} vs {by_hand}",
+                rock.id,
+                rock.bearing_column
+            );
+        }
+    }
+    check_centroids_and_contacts(&truth, &calib);
+}
+
+/// Pairs of 4-neighbouring pixels showing two different rocks: where rocks touch in the image.
+fn touching_pixels(image: &qrm_synth::Render) -> usize {
+    let w = image.width as usize;
+    let id = &image.rock_id;
+    (0..id.len())
+        .filter(|&i| {
+            let different = |j: usize| id[j] != 0 && id[i] != 0 && id[j] != id[i];
+            (i % w + 1 < w && different(i + 1)) || (i + w < id.len() && different(i + w))
+        })
+        .count()
+}
+
+#[test]
+fn clustered_rocks_touch_in_the_panoramas() {
+    let calib = calibration(0.25);
+    let touching = |cluster: f64| -> usize {
+        let layout = Preset::Marsyard.layout_clustered(4, Counts::default(), cluster);
+        let world = World::generate(4, &layout.rocks);
+        layout.stations[..10]
+            .iter()
+            .map(|&pose| touching_pixels(&render_image(&world, &calib, pose, Eye::Mono)))
+            .sum()
+    };
+    let (plain, clustered) = (touching(0.0), touching(0.6));
+    assert!(
+        clustered > 2 * plain,
+        "touching pixel pairs: {plain} as laid out, {clustered} clustered"
+    );
+}
+
+/// A `stress` member with the camera scaled down further by `scale`.
+fn stress(seed: u64, scale: f64, dir: &std::path::Path) -> (Variant, Truth) {
+    let variant = Variant::stress(seed);
+    let calib = variant.calibration(&calibration(scale)).unwrap();
+    let truth = write_dataset(
+        dir,
+        &calib,
+        Request {
+            preset: Preset::Stress,
+            seed,
+            counts: Counts {
+                rocks: None,
+                stations: Some(2),
+            },
+            stereo: true,
+            scenery: variant.scenery,
+            capture: variant.capture,
+            encoding: variant.encoding,
+        },
+        &|| {},
+    )
+    .unwrap();
+    (variant, truth)
+}
+
+fn same_files(a: &std::path::Path, b: &std::path::Path, truth: &Truth) -> bool {
+    truth
+        .images
+        .iter()
+        .map(|i| i.file.as_str())
+        .chain(["calib.toml"])
+        .all(|f| std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap())
+}
+
+/// A `stress` member is the same bytes every time, records its draws in `truth.json`, and is
+/// exactly its layout preset rendered with the drawn options.
+#[test]
+fn stress_members_are_reproducible_and_record_their_draws() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = |name: &str| scratch.path().join(name);
+    for seed in [2, 5] {
+        let (variant, truth) = stress(seed, 0.2, &dir("a"));
+        let (_, again) = stress(seed, 0.2, &dir("b"));
+        assert_eq!(truth, again);
+        assert!(same_files(&dir("a"), &dir("b"), &truth));
+        let record = truth
+            .variant
+            .clone()
+            .expect("stress sets record their variant");
+        let calib = Calibration::load(&dir("a").join("calib.toml")).unwrap();
+        assert_eq!(truth.preset, "stress");
+        assert_eq!(record.layout, variant.layout.name());
+        assert_eq!(
+            Some(record.sun_elevation_deg),
+            variant.scenery.sun_elevation_deg
+        );
+        assert_eq!(
+            (record.rock_albedo_contrast, record.cluster),
+            (
+                variant.scenery.rock_albedo_contrast,
+                variant.scenery.cluster
+            )
+        );
+        assert_eq!(
+            (
+                record.gamma,
+                record.noise,
+                record.blur_px,
+                record.jpeg_quality
+            ),
+            (
+                variant.capture.gamma,
+                variant.capture.noise,
+                variant.capture.blur_px,
+                variant.encoding.jpeg_quality
+            )
+        );
+        assert_eq!(
+            (record.column_direction, record.column0_deg),
+            (calib.azimuth.direction, calib.azimuth.column0_deg)
+        );
+        assert_eq!(calib.azimuth, variant.column_axis);
+        assert_eq!(
+            (record.width, record.height),
+            (calib.image.width, calib.image.height)
+        );
+        // The layout preset with the same options renders the same member.
+        let layout = write_dataset(
+            &dir("layout"),
+            &calib,
+            Request {
+                preset: variant.layout,
+                seed,
+                counts: Counts {
+                    rocks: None,
+                    stations: Some(2),
+                },
+                stereo: true,
+                scenery: variant.scenery,
+                capture: variant.capture,
+                encoding: variant.encoding,
+            },
+            &|| {},
+        )
+        .unwrap();
+        assert_eq!(
+            (&layout.rocks, &layout.stations, &layout.images),
+            (&truth.rocks, &truth.stations, &truth.images)
+        );
+        assert!(same_files(&dir("a"), &dir("layout"), &truth));
+    }
+    let (_, other) = stress(5, 0.2, &dir("c"));
+    let (_, first) = stress(2, 0.2, &dir("d"));
+    assert_ne!(other.variant, first.variant);
+    assert_ne!(other.rocks, first.rocks);
 }
 
 #[test]
@@ -140,6 +350,7 @@ fn committed_demo_dataset_is_reproduced_byte_for_byte() {
                 stations: Some(16),
             },
             stereo: true,
+            scenery: Scenery::default(),
             capture: Capture::default(),
             encoding: Encoding::default(),
         },
@@ -175,6 +386,7 @@ fn grayscale_jpeg_datasets_are_written_as_asked() {
             stations: Some(2),
         },
         stereo: false,
+        scenery: Scenery::default(),
         capture: Capture::default(),
         encoding,
     };

@@ -197,6 +197,24 @@ fn synthesises_a_dataset_and_rejects_bad_calibrations() {
         ],
         vec!["synth", "--scale", "0", "--out", "/tmp/never"],
         vec!["synth", "--stations", "0", "--out", "/tmp/never"],
+        vec!["synth", "--sun-elevation", "1", "--out", "/tmp/never"],
+        vec![
+            "synth",
+            "--rock-albedo-contrast",
+            "1.5",
+            "--out",
+            "/tmp/never",
+        ],
+        vec!["synth", "--cluster", "-0.1", "--out", "/tmp/never"],
+        vec![
+            "synth",
+            "--preset",
+            "stress",
+            "--gamma",
+            "9",
+            "--out",
+            "/tmp/never",
+        ],
     ] {
         let o = pipeline(&args);
         assert_eq!(o.status.code(), Some(2), "{args:?}");
@@ -212,4 +230,54 @@ fn synthesises_a_dataset_and_rejects_bad_calibrations() {
     ]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("height_m"));
     assert!(!std::path::Path::new("/tmp/never").exists());
+}
+
+/// `--preset stress` prints its draws and records them in `truth.json`, writes the drawn column
+/// axis into `calib.toml`, and lets an option given replace its draw.
+#[test]
+fn synthesises_a_stress_member() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let args = |seed: &'static str, extra: &[&'static str]| {
+        let mut a = vec![
+            "synth",
+            "--preset",
+            "stress",
+            "--seed",
+            seed,
+            "--stations",
+            "2",
+            "--mono",
+            "--scale",
+            "0.1",
+            "--out",
+        ];
+        a.push(dir.to_str().unwrap());
+        a.extend(extra);
+        pipeline(&a)
+    };
+    let o = args("4", &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let printed = stdout(&o);
+    assert!(printed.contains("stress (seed 4)"), "{printed}");
+    assert!(printed.contains("variant: layout "), "{printed}");
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    assert_eq!(truth["preset"], "stress");
+    let variant = &truth["variant"];
+    assert!(["marsyard", "random"].contains(&variant["layout"].as_str().unwrap()));
+    assert_eq!(variant["width"], 410);
+    let calib = std::fs::read_to_string(dir.join("calib.toml")).unwrap();
+    let direction = variant["column_direction"].as_str().unwrap();
+    assert!(
+        calib.contains(&format!("direction = \"{direction}\"")),
+        "{calib}"
+    );
+    let o = args("4", &["--sun-elevation", "8", "--jpeg", "85"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    assert_eq!(truth["variant"]["sun_elevation_deg"], 8.0);
+    assert_eq!(truth["variant"]["jpeg_quality"], 85);
+    assert!(dir.join("station_000.jpg").is_file());
 }

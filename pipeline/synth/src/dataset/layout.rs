@@ -4,6 +4,7 @@
 
 use crate::Pose;
 use qrm_core::geometry::Point;
+use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::TAU;
@@ -18,6 +19,10 @@ pub enum Preset {
     Random,
     /// 200 rocks over 200 m × 200 m; a long meandering traverse.
     SparseLarge,
+    /// A family, one member per seed (issue 13): the layout of `Marsyard` or `Random`, with
+    /// scene, camera and calibration variations all drawn from the seed
+    /// ([`super::Variant::stress`]).
+    Stress,
 }
 
 /// Rock placements (ground position, characteristic radius) and imaging poses.
@@ -44,35 +49,94 @@ impl Preset {
             Preset::Marsyard => "marsyard",
             Preset::Random => "random",
             Preset::SparseLarge => "sparse-large",
+            Preset::Stress => "stress",
+        }
+    }
+
+    /// The preset whose layout `seed` uses: itself, or for `Stress` the layout it draws.
+    pub fn layout_preset(self, seed: u64) -> Preset {
+        match self {
+            Preset::Stress => super::Variant::stress(seed).layout,
+            preset => preset,
         }
     }
 
     /// The layout of this preset for `seed`.
     pub fn layout(self, seed: u64, counts: Counts) -> Layout {
+        self.layout_clustered(seed, counts, 0.0)
+    }
+
+    /// The layout of this preset for `seed` with a `cluster` fraction of its rocks gathered
+    /// into dense clusters ([`crate::Scenery::cluster`]). The rocks are moved with their own
+    /// random stream before the imaging points are drawn, so that `cluster` 0 is exactly
+    /// [`Preset::layout`] and imaging points keep their clearance from the moved rocks.
+    pub fn layout_clustered(self, seed: u64, counts: Counts, cluster: f64) -> Layout {
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x1a70_0117);
         match self {
             Preset::Marsyard => {
                 let n = counts.rocks.unwrap_or(30);
-                let rocks = clustered_field(&mut rng, n, 20.0, 3);
+                let rocks = gather(seed, clustered_field(&mut rng, n, 20.0, 3), cluster);
                 let stations = loop_traverse(&mut rng, &rocks, 20.0, counts.stations.unwrap_or(50));
                 Layout { rocks, stations }
             }
             Preset::Random => {
                 let n = counts.rocks.unwrap_or(30);
-                let rocks = uniform_field(&mut rng, n, 30.0, (0.15, 0.5));
+                let rocks = gather(seed, uniform_field(&mut rng, n, 30.0, (0.15, 0.5)), cluster);
                 let stations =
                     random_stations(&mut rng, &rocks, 30.0, counts.stations.unwrap_or(50));
                 Layout { rocks, stations }
             }
             Preset::SparseLarge => {
                 let n = counts.rocks.unwrap_or(200);
-                let rocks = uniform_field(&mut rng, n, 200.0, (0.3, 1.2));
+                let rocks = gather(seed, uniform_field(&mut rng, n, 200.0, (0.3, 1.2)), cluster);
                 let stations =
                     meander_traverse(&mut rng, &rocks, 200.0, counts.stations.unwrap_or(120));
                 Layout { rocks, stations }
             }
+            Preset::Stress => self
+                .layout_preset(seed)
+                .layout_clustered(seed, counts, cluster),
         }
     }
+}
+
+/// Gathers a `fraction` of the rocks into dense clusters of about five, where each newcomer
+/// touches or overlaps a rock already there: its centre lies 0.4–0.85 of the two radii from
+/// that rock's (a rock's footprint reaches about 0.3–1.1 radii from its centre, so the two
+/// meet or interpenetrate), and no nearer than 0.4 of the two radii to any rock, so that none
+/// swallows another. The first rock of each cluster stays where it was; a rock that finds no
+/// such place in 50 tries stays too. Drawn from a stream of its own, so that the preset's
+/// other draws do not change.
+fn gather(seed: u64, mut rocks: Vec<(Point, f64)>, fraction: f64) -> Vec<(Point, f64)> {
+    let gathered = ((fraction * rocks.len() as f64).round() as usize).min(rocks.len());
+    if gathered < 2 {
+        return rocks;
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xc1a5_7e25);
+    let mut order: Vec<usize> = (0..rocks.len()).collect();
+    order.shuffle(&mut rng);
+    let cores = gathered.div_ceil(5);
+    let mut clusters: Vec<Vec<usize>> = order[..cores].iter().map(|&i| vec![i]).collect();
+    for (j, &i) in order[cores..gathered].iter().enumerate() {
+        let cluster = &mut clusters[j % cores];
+        let r = rocks[i].1;
+        for _ in 0..50 {
+            let (q, s) = rocks[cluster[rng.random_range(0..cluster.len())]];
+            let angle = rng.random_range(0.0..TAU);
+            let distance = (r + s) * rng.random_range(0.4..0.85);
+            let p = Point::new(q.x + distance * angle.cos(), q.y + distance * angle.sin());
+            let room = rocks
+                .iter()
+                .enumerate()
+                .all(|(k, &(o, t))| k == i || o.distance(p) >= 0.4 * (r + t));
+            if room {
+                rocks[i].0 = p;
+                cluster.push(i);
+                break;
+            }
+        }
+    }
+    rocks
 }
 
 /// Rocks uniform in a `side` square, radii uniform in `sizes`, not overlapping.
@@ -224,6 +288,73 @@ mod tests {
                 assert!(clear(s.position, &layout.rocks), "{preset:?}");
             }
             assert_eq!(layout, preset.layout(7, Counts::default()), "deterministic");
+        }
+    }
+
+    /// Whether ground point (x, y) lies in the rock's footprint: inside one of its lumps.
+    fn in_footprint(rock: &crate::Rock, x: f64, y: f64) -> bool {
+        rock.lumps.iter().any(|l| {
+            let (dx, dy) = (
+                x - rock.position.x - l.center[0],
+                y - rock.position.y - l.center[1],
+            );
+            let (c, s) = (l.yaw.cos(), l.yaw.sin());
+            let (u, v) = (c * dx + s * dy, -s * dx + c * dy);
+            let w = (l.center[2] - rock.burial) / l.radii[2];
+            (u / l.radii[0]).powi(2) + (v / l.radii[1]).powi(2) + w * w <= 1.0
+        })
+    }
+
+    /// Pairs of rocks whose footprints overlap or come within 2 cm (sampled every centimetre).
+    fn touching_pairs(world: &crate::World) -> usize {
+        let rocks = &world.rocks;
+        let mut pairs = 0;
+        for (i, a) in rocks.iter().enumerate() {
+            for b in &rocks[i + 1..] {
+                let reach = 1.5 * (a.size + b.size);
+                if a.position.distance(b.position) > reach {
+                    continue;
+                }
+                let samples = |rock: &crate::Rock| -> Vec<Point> {
+                    let n = (1.5 * rock.size / 0.01).ceil() as i32;
+                    (-n..=n)
+                        .flat_map(|i| (-n..=n).map(move |j| (i, j)))
+                        .map(|(i, j)| {
+                            Point::new(
+                                rock.position.x + 0.01 * f64::from(i),
+                                rock.position.y + 0.01 * f64::from(j),
+                            )
+                        })
+                        .filter(|p| in_footprint(rock, p.x, p.y))
+                        .collect()
+                };
+                let (sa, sb) = (samples(a), samples(b));
+                if sa.iter().any(|p| sb.iter().any(|q| p.distance(*q) <= 0.02)) {
+                    pairs += 1;
+                }
+            }
+        }
+        pairs
+    }
+
+    #[test]
+    fn clusters_make_footprints_touch_and_keep_stations_clear() {
+        for preset in [Preset::Marsyard, Preset::Random] {
+            let plain = preset.layout(5, Counts::default());
+            assert_eq!(preset.layout_clustered(5, Counts::default(), 0.0), plain);
+            let packed = preset.layout_clustered(5, Counts::default(), 0.5);
+            assert_eq!(packed.stations.len(), 50, "{preset:?}");
+            for s in &packed.stations {
+                assert!(clear(s.position, &packed.rocks), "{preset:?}");
+            }
+            let sizes = |l: &Layout| l.rocks.iter().map(|r| r.1).collect::<Vec<_>>();
+            assert_eq!(sizes(&packed), sizes(&plain), "the same rocks, moved");
+            let touching = |l: &Layout| touching_pairs(&crate::World::generate(5, &l.rocks));
+            let (before, after) = (touching(&plain), touching(&packed));
+            assert!(
+                after >= before + 8,
+                "{preset:?}: {before} → {after} touching pairs"
+            );
         }
     }
 

@@ -4,10 +4,12 @@
 
 mod layout;
 mod truth;
+mod variant;
 mod writer;
 
 pub use layout::{Counts, Layout, Preset};
 pub use truth::{
-    visible_rocks, ImageTruth, LumpTruth, RockTruth, StationTruth, Truth, VisibleRock,
+    visible_rocks, ImageTruth, LumpTruth, RockTruth, StationTruth, Truth, VariantTruth, VisibleRock,
 };
+pub use variant::Variant;
 pub use writer::{write_dataset, DatasetError, Request};

@@ -2,7 +2,7 @@
 //! evaluation reads it; the pipeline proper never does.
 
 use crate::{optical_centre, Eye, Pose, Render, World};
-use qrm_vision::calib::Calibration;
+use qrm_vision::calib::{Calibration, ColumnDirection};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -15,10 +15,40 @@ pub struct Truth {
     pub rocks: Vec<RockTruth>,
     pub stations: Vec<StationTruth>,
     pub images: Vec<ImageTruth>,
+    /// How the set departs from its preset's own look, when it does (`--preset stress`, or
+    /// scene, camera or encoding options): a record for people and reports, read by nothing
+    /// else. Absent otherwise, so that such sets' files stay as they always were.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant: Option<VariantTruth>,
 }
 
 pub const FORMAT: &str = "qrm-truth";
 pub const VERSION: u32 = 1;
+
+/// The scene, camera, encoding and calibration a set was rendered with (`datasets/README.md`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VariantTruth {
+    /// The preset whose layout was used (`marsyard` or `random` for `stress`).
+    pub layout: String,
+    /// Sun elevation, degrees: asked for, or the world's own draw.
+    pub sun_elevation_deg: f64,
+    pub rock_albedo_contrast: f64,
+    pub cluster: f64,
+    pub exposure_ev: f64,
+    pub gamma: f64,
+    pub vignetting: f64,
+    pub blur_px: f32,
+    pub noise: f64,
+    pub grayscale: bool,
+    pub jpeg_quality: Option<u8>,
+    /// The calibration's `azimuth.direction` and `azimuth.column0_deg`.
+    pub column_direction: ColumnDirection,
+    pub column0_deg: f64,
+    /// Panorama size, pixels.
+    pub width: u32,
+    pub height: u32,
+}
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

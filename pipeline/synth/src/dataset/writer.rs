@@ -2,8 +2,10 @@
 //! panoramas and `truth.json`, each file written atomically.
 
 use super::layout::{Counts, Layout, Preset};
-use super::truth::{visible_rocks, ImageTruth, RockTruth, StationTruth, Truth, FORMAT, VERSION};
-use crate::{render, Capture, Encoding, Eye, Render, World};
+use super::truth::{
+    visible_rocks, ImageTruth, RockTruth, StationTruth, Truth, VariantTruth, FORMAT, VERSION,
+};
+use crate::{render, Capture, Encoding, Eye, Render, Scenery, World};
 use qrm_vision::calib::Calibration;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -31,6 +33,8 @@ pub struct Request {
     pub counts: Counts,
     /// A left and a right panorama per station, or one mono panorama.
     pub stereo: bool,
+    /// Sun, rock colours and clustering (all default: the preset's own scene).
+    pub scenery: Scenery,
     /// Camera effects on every image (noise drawn per image from the seed).
     pub capture: Capture,
     pub encoding: Encoding,
@@ -47,8 +51,12 @@ pub fn write_dataset(
         path: dir.to_path_buf(),
         source,
     })?;
-    let Layout { rocks, stations } = request.preset.layout(request.seed, request.counts);
-    let world = World::generate(request.seed, &rocks);
+    let Layout { rocks, stations } =
+        request
+            .preset
+            .layout_clustered(request.seed, request.counts, request.scenery.cluster);
+    let mut world = World::generate(request.seed, &rocks);
+    request.scenery.apply(&mut world);
     let eyes: &[(Eye, &str)] = if request.stereo {
         &[(Eye::Left, "left"), (Eye::Right, "right")]
     } else {
@@ -105,11 +113,43 @@ pub fn write_dataset(
             })
             .collect(),
         images: per_station.into_iter().flatten().collect(),
+        variant: varied(&request).then(|| VariantTruth {
+            layout: request
+                .preset
+                .layout_preset(request.seed)
+                .name()
+                .to_string(),
+            sun_elevation_deg: request
+                .scenery
+                .sun_elevation_deg
+                .unwrap_or(world.sun_elevation.to_degrees()),
+            rock_albedo_contrast: request.scenery.rock_albedo_contrast,
+            cluster: request.scenery.cluster,
+            exposure_ev: request.capture.exposure_ev,
+            gamma: request.capture.gamma,
+            vignetting: request.capture.vignetting,
+            blur_px: request.capture.blur_px,
+            noise: request.capture.noise,
+            grayscale: request.encoding.grayscale,
+            jpeg_quality: request.encoding.jpeg_quality,
+            column_direction: calib.azimuth.direction,
+            column0_deg: calib.azimuth.column0_deg,
+            width: calib.image.width,
+            height: calib.image.height,
+        }),
     };
     let json = serde_json::to_string_pretty(&truth).expect("plain data serialises") + "\n";
     write_file(&dir.join("truth.json"), json.as_bytes())?;
     write_file(&dir.join("calib.toml"), calib.to_toml().as_bytes())?;
     Ok(truth)
+}
+
+/// Whether `request` departs from its preset's own look, so that `truth.json` records how.
+fn varied(request: &Request) -> bool {
+    request.preset == Preset::Stress
+        || !request.scenery.is_default()
+        || !request.capture.is_identity()
+        || request.encoding != Encoding::default()
 }
 
 fn write_file(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
