@@ -12,6 +12,7 @@ use qrm_core::map::Hypergraph;
 use qrm_core::neighborhood::estimate;
 use qrm_plot::{spring_layout, write_rng, RngPicture};
 use qrm_vision::calib::Calibration;
+use qrm_vision::detection::Channels;
 use qrm_vision::run::{
     detect_survey, map_stations, Mapper, Progress, RunSettings, RunSummary, Stage, StationRecord,
 };
@@ -41,6 +42,29 @@ pub struct RunArgs {
     /// Also write OUT/run.rrd for the rerun viewer (needs a build with `--features rerun`).
     #[arg(long)]
     pub rrd: bool,
+    /// What tells rocks from the ground: `luminance` uses brightness and stereo height only
+    /// (grayscale cameras, and colour that cannot be trusted); `auto` picks it for grayscale
+    /// panoramas and colour otherwise.
+    #[arg(long, value_enum, default_value_t = ChannelsArg::Auto)]
+    pub channels: ChannelsArg,
+}
+
+/// `--channels` (`qrm_vision::detection::Channels`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ChannelsArg {
+    Auto,
+    Colour,
+    Luminance,
+}
+
+impl From<ChannelsArg> for Channels {
+    fn from(c: ChannelsArg) -> Channels {
+        match c {
+            ChannelsArg::Auto => Channels::Auto,
+            ChannelsArg::Colour => Channels::Colour,
+            ChannelsArg::Luminance => Channels::Luminance,
+        }
+    }
 }
 
 /// The recorders of the run: run.mcap always, run.rrd on request.
@@ -141,7 +165,8 @@ pub fn run(args: RunArgs) -> Result<()> {
         bail!("--rrd needs a build with the rerun feature: cargo build --release -p pipeline --features rerun");
     }
 
-    let settings = RunSettings::default();
+    let mut settings = RunSettings::default();
+    settings.detector.channels = args.channels.into();
     let bars = Bars::default();
     let detected = match detect_survey(&survey, &calib, &settings.detector, &bars) {
         Ok(detected) => detected,

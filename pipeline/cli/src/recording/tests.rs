@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use super::*;
+use qrm_vision::detection::Channels;
 use qrm_vision::run::{
     Association, DetectionRecord, FusionRecord, MetricsRecord, RangeRecord, StageSeconds,
 };
@@ -41,6 +42,7 @@ fn station(index: usize) -> StationRecord {
                 ],
                 centroid: [f64::from(column) + 30.0, 360.0],
                 contact_row: 420.0,
+                contact_slack_rows: 0.0,
                 pixels: 5000 + k as u32,
                 stereo_column: (k % 2 == 0).then_some(f64::from(column) + 22.5),
                 bearing: k as f64 * 1.5 - 3.0,
@@ -72,9 +74,11 @@ fn station(index: usize) -> StationRecord {
             format!("station_{index:03}_left.png"),
             format!("station_{index:03}_right.png"),
         ],
+        channels: Channels::Colour,
         detections,
         order: vec![(0, 1), (0, 2)],
         fusion: FusionRecord {
+            usable: count,
             landmarks: count,
             triples: count * (count - 1) * (count - 2) / 6,
             relations_tightened: index,

@@ -10,6 +10,7 @@
 //! the flat-ground range of their contact row, which removes pebbles at every resolution.
 
 mod components;
+mod ground;
 mod parallax;
 mod split;
 
@@ -54,6 +55,46 @@ pub struct DetectorSettings {
     pub split_depth_fraction: f32,
     /// When a blob holding a nearer and a farther rock is separated by stereo parallax.
     pub parallax: ParallaxRule,
+    /// Which channels tell rock from regolith.
+    #[serde(default)]
+    pub channels: Channels,
+    /// In luminance mode, a pixel off the flat ground (by stereo) is rock if its luminance
+    /// differs from its row's median by this fraction either way.
+    #[serde(default = "default_luminance_contrast")]
+    pub luminance_contrast: f32,
+}
+
+fn default_luminance_contrast() -> f32 {
+    0.08
+}
+
+/// What tells rock pixels from regolith.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Channels {
+    /// Luminance for grayscale panoramas (every pixel's channels equal), colour otherwise.
+    #[default]
+    Auto,
+    /// Chroma and luminance: rocks are greyer than the red regolith; cast shadows stay red.
+    Colour,
+    /// Luminance and stereo: a pixel is rock if it differs from the row's regolith in
+    /// luminance and does not lie on the flat ground (`ground`); cast shadows and soil
+    /// patches do. Without a right panorama, shadows cannot be told from rocks: every
+    /// detection is then flagged ambiguous.
+    Luminance,
+}
+
+impl Channels {
+    /// The mode `image` is detected in: `Auto` resolved by whether it holds any colour.
+    pub fn resolve(self, image: &image::RgbImage) -> Channels {
+        match self {
+            Channels::Auto if image.pixels().all(|p| p[0] == p[1] && p[1] == p[2]) => {
+                Channels::Luminance
+            }
+            Channels::Auto => Channels::Colour,
+            other => other,
+        }
+    }
 }
 
 impl Default for DetectorSettings {
@@ -69,6 +110,8 @@ impl Default for DetectorSettings {
             dark_chroma_drop: 0.02,
             split_depth_px: 2.0,
             split_depth_fraction: 0.15,
+            channels: Channels::Auto,
+            luminance_contrast: default_luminance_contrast(),
             parallax: ParallaxRule {
                 radius: 2,
                 min_pixels: 60,
@@ -97,6 +140,10 @@ pub struct Detection {
     pub pixels: u32,
     /// Continuous row of the bottom edge of the rock itself (its ground contact).
     pub contact_row: f64,
+    /// Rows below `contact_row` the true contact may lie: in luminance mode a rock's lowest
+    /// rows cannot be told from the ground by stereo.
+    #[serde(default)]
+    pub contact_slack_rows: f64,
     pub appearance: Appearance,
     /// May be several rocks (its bottom edge is notched, but too shallowly to cut), or only the
     /// visible part of a rock cut from a nearer one in front of it: do not use its bearing.
@@ -122,13 +169,42 @@ pub struct Appearance {
     pub dark_fraction: f32,
 }
 
+/// The panoramas of a stereo pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Eye {
+    Left,
+    Right,
+}
+
 /// Detects rocks in `image`, sorted by centroid column. Given the right panorama of its
 /// stereo pair (`image` being the left), blobs of a nearer and a farther rock are also
-/// separated by parallax. An image whose size differs from the calibration's yields no
-/// detections (its geometry would be meaningless); a right panorama of another size is ignored.
+/// separated by parallax, and in luminance mode rocks are told from the ground by stereo. An
+/// image whose size differs from the calibration's yields no detections (its geometry would be
+/// meaningless); a right panorama of another size is ignored.
 pub fn detect(
     image: &image::RgbImage,
     right: Option<&image::RgbImage>,
+    calib: &Calibration,
+    settings: &DetectorSettings,
+) -> Vec<Detection> {
+    detect_in(image, right.map(|r| (r, Eye::Right)), calib, settings)
+}
+
+/// Detects rocks in the right panorama of a stereo pair, given its left partner: as
+/// [`detect`], but without parallax separation (its detections serve the stereo cue only).
+pub fn detect_right(
+    image: &image::RgbImage,
+    left: Option<&image::RgbImage>,
+    calib: &Calibration,
+    settings: &DetectorSettings,
+) -> Vec<Detection> {
+    detect_in(image, left.map(|l| (l, Eye::Left)), calib, settings)
+}
+
+/// Detects rocks in `image` given the other panorama of its pair and which one that is.
+fn detect_in(
+    image: &image::RgbImage,
+    other: Option<(&image::RgbImage, Eye)>,
     calib: &Calibration,
     settings: &DetectorSettings,
 ) -> Vec<Detection> {
@@ -143,8 +219,42 @@ pub fn detect(
     }
     let raw = &image.as_raw()[top * w * 3..];
     let background = row_medians(raw, w);
-    let Some(mask) = rock_mask(raw, &background, w, rows, settings) else {
+    let bands = other
+        .filter(|(o, _)| o.dimensions() == image.dimensions() && calib.stereo.baseline_m > 0.0)
+        .map(|(o, _)| (ground_luminance(image, top), ground_luminance(o, top)));
+    // The right camera sees a point turned towards increasing azimuth, the left one away.
+    let towards = if calib.column_sign() > 0.0 { 1 } else { -1 };
+    let direction = match other {
+        Some((_, Eye::Left)) => -towards,
+        _ => towards,
+    };
+    let luminance = settings.channels.resolve(image) == Channels::Luminance;
+    let stances = bands
+        .as_ref()
+        .filter(|_| luminance)
+        .map(|(own, other)| ground::stances(own, other, w, top, calib, direction));
+    let pixels_rule = match (luminance, &stances) {
+        (false, _) => PixelRule::Colour,
+        (true, Some(stances)) => PixelRule::OffGround(stances),
+        (true, None) => PixelRule::Luminance,
+    };
+    let Some(mask) = rock_mask(raw, &background, w, rows, settings, &pixels_rule) else {
         return Vec::new();
+    };
+    // Without stereo, a luminance-only mask holds cast shadows with the rocks: neither the
+    // centroid nor the contact can be trusted.
+    let doubted = matches!(pixels_rule, PixelRule::Luminance);
+    // With stereo, the contact is the lowest row standing up from the ground, and the rows
+    // under it that the test cannot tell from the ground are doubt.
+    let raised_bottom = |piece: &components::Component| -> Option<f64> {
+        let stances = stances.as_ref()?;
+        piece
+            .iter()
+            .filter(|&&(col, row)| {
+                stances[row as usize * w + col as usize % w] == ground::Stance::Raised
+            })
+            .map(|&(_, row)| (row as usize + top + 1) as f64)
+            .max_by(f64::total_cmp)
     };
     let sample = |col: usize, row: usize| {
         let i = row * w + col;
@@ -157,21 +267,28 @@ pub fn detect(
             dark: ratio < settings.dark_ratio,
         }
     };
+    // Notch splitting and ambiguity are measured against the contact's doubt.
+    let slack = if stances.is_some() {
+        ground::contact_of(0.0, calib).1
+    } else {
+        0.0
+    };
+    // A bottom edge found by stereo is ragged by the rows the test cannot tell from the
+    // ground: only notches deeper than that mark two rocks (half the cutting depth).
     let rule = split::SplitRule {
-        min_depth: settings.split_depth_px,
+        min_depth: settings.split_depth_px.max(2.0 * slack as f32),
         fraction: settings.split_depth_fraction,
         min_columns: 3,
     };
-    let bands = right
-        .filter(|r| r.dimensions() == image.dimensions() && calib.stereo.baseline_m > 0.0)
-        .map(|r| (ground_luminance(image, top), ground_luminance(r, top)));
-    // The right camera sees a point turned towards increasing azimuth.
-    let partner = bands.as_ref().map(|(own, other)| parallax::Partner {
+    let separable = bands
+        .as_ref()
+        .filter(|_| matches!(other, Some((_, Eye::Right))));
+    let partner = separable.map(|(own, other)| parallax::Partner {
         own,
         other,
         width: w,
         rows,
-        direction: if calib.column_sign() > 0.0 { 1 } else { -1 },
+        direction,
         column_width: calib.column_width(),
         baseline_m: calib.stereo.baseline_m,
     });
@@ -199,7 +316,17 @@ pub fn detect(
         })
         .filter_map(|(blob, piece, part)| {
             let pixels = blob_of(&piece.pixels, w, &sample);
-            let mut detection = accept(pixels, piece.ambiguous, top, calib, settings)?;
+            let mut detection = accept(pixels, piece.ambiguous || doubted, top, calib, settings)?;
+            if stances.is_some() {
+                // A piece with nothing standing up from the ground is not a rock.
+                let (contact, doubt) = ground::contact_of(raised_bottom(&piece.pixels)?, calib);
+                detection.contact_row = contact;
+                detection.contact_slack_rows = doubt;
+                // A piece shorter than the rows the test cannot see is the top of a rock whose
+                // body it missed: its width and centroid may be off the rock's.
+                let rows = f64::from(detection.bbox[3] - detection.bbox[1] + 1);
+                detection.ambiguous |= rows < doubt;
+            }
             detection.separation = part;
             detection.blob = blob;
             Some(detection)
@@ -209,6 +336,16 @@ pub fn detect(
     detections
 }
 
+/// How a pixel is told to be rock.
+enum PixelRule<'a> {
+    /// By chroma and luminance ([`segment`]).
+    Colour,
+    /// By luminance, off the flat ground (the stereo test's stance of each pixel of the band).
+    OffGround(&'a [ground::Stance]),
+    /// By luminance alone (no stereo partner).
+    Luminance,
+}
+
 /// The closed mask of rock pixels of the ground rows `raw` (`rows` × `w`, RGB).
 fn rock_mask(
     raw: &[u8],
@@ -216,8 +353,15 @@ fn rock_mask(
     w: usize,
     rows: usize,
     settings: &DetectorSettings,
+    rule: &PixelRule,
 ) -> Option<Image<u8, 1>> {
-    let mut mask = segment(raw, background, w, settings);
+    let mut mask = match rule {
+        PixelRule::Colour => segment(raw, background, w, settings),
+        PixelRule::OffGround(stances) => {
+            segment_luminance(raw, background, w, settings, Some(stances))
+        }
+        PixelRule::Luminance => segment_luminance(raw, background, w, settings, None),
+    };
     close3(&mut mask, w);
     Image::<u8, 1>::new(
         ImageSize {
@@ -336,6 +480,75 @@ fn segment(raw: &[u8], background: &[(f32, f32)], w: usize, s: &DetectorSettings
     mask
 }
 
+/// Rock pixels (255) of the ground band by luminance: pixels `luminance_contrast` brighter or
+/// darker than the row's median (rock faces lit or shaded, and cast shadows) or standing up
+/// from the ground by stereo, kept where they lie between raised pixels of their row
+/// ([`between_raised`]). Without `stances`, every pixel that contrast brighter or darker,
+/// shadows included.
+fn segment_luminance(
+    raw: &[u8],
+    background: &[(f32, f32)],
+    w: usize,
+    s: &DetectorSettings,
+    stances: Option<&[ground::Stance]>,
+) -> Vec<u8> {
+    let mut contrasted = vec![false; w * background.len()];
+    for (y, (row, out)) in raw
+        .chunks_exact(3 * w)
+        .zip(contrasted.chunks_exact_mut(w))
+        .enumerate()
+    {
+        let bg = background[y].0;
+        let (low, high) = (
+            (1.0 - s.luminance_contrast) * bg,
+            (1.0 + s.luminance_contrast) * bg,
+        );
+        for (p, c) in row.chunks_exact(3).zip(out.iter_mut()) {
+            let sum = f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2]);
+            *c = sum < low || sum > high;
+        }
+    }
+    let rock = match stances {
+        Some(stances) => {
+            // Standing up from the ground is what makes a rock, whatever its shade.
+            for (c, s) in contrasted.iter_mut().zip(stances) {
+                *c |= *s == ground::Stance::Raised;
+            }
+            between_raised(&contrasted, stances, w)
+        }
+        None => contrasted,
+    };
+    rock.into_iter().map(|r| if r { 255 } else { 0 }).collect()
+}
+
+/// For each pixel of `inside`: whether it lies, within its row's run of `inside` pixels,
+/// between the run's first and last pixel standing up from the ground. A rock's smooth face
+/// lies between its textured, raised edges; a cast shadow beside it lies outside them, and
+/// the rows of a shadow in front of it hold nothing raised.
+fn between_raised(inside: &[bool], stances: &[ground::Stance], w: usize) -> Vec<bool> {
+    let mut out = vec![false; inside.len()];
+    for (y, row) in inside.chunks_exact(w).enumerate() {
+        let mut x = 0;
+        while x < w {
+            if !row[x] {
+                x += 1;
+                continue;
+            }
+            let start = x;
+            while x < w && row[x] {
+                x += 1;
+            }
+            let raised = |&i: &usize| stances[y * w + i] == ground::Stance::Raised;
+            let first = (start..x).find(raised);
+            let last = (start..x).rev().find(raised);
+            if let (Some(first), Some(last)) = (first, last) {
+                out[y * w + first..=y * w + last].fill(true);
+            }
+        }
+    }
+    out
+}
+
 /// Morphological closing of `mask` (`w` wide) by a 3 × 3 square, the neighbourhood clipped at
 /// the image's edges: it bridges one-pixel cracks inside rocks. Separable u8 max/min passes,
 /// several times faster than a distance transform.
@@ -416,6 +629,7 @@ fn accept(
         ],
         pixels: blob.pixels,
         contact_row,
+        contact_slack_rows: 0.0,
         appearance,
         ambiguous,
         separation: Separation::Whole,
@@ -456,7 +670,10 @@ fn lies_flat(top_row: f64, range: f64, width_m: f64, calib: &Calibration, min_ri
 
 #[cfg(test)]
 mod tests {
-    use super::{close3, ground_tint, lies_flat, Appearance, DetectorSettings};
+    use super::ground::Stance;
+    use super::{
+        between_raised, close3, ground_tint, lies_flat, Appearance, Channels, DetectorSettings,
+    };
     use crate::calib::Calibration;
 
     /// A smooth blob as bright as the regolith is a tint of it; a textured one, or a smooth
@@ -493,6 +710,38 @@ mod tests {
             &calib,
             0.9
         ));
+    }
+
+    /// A rock's smooth middle lies between its raised edges and is kept; the dark shadow beside
+    /// it, in the same run of contrasted pixels, is not, nor is a run with nothing raised.
+    #[test]
+    fn only_what_lies_between_raised_pixels_is_rock() {
+        let (r, g, u) = (Stance::Raised, Stance::Ground, Stance::Unknown);
+        let inside = [
+            true, true, true, true, true, true, true, false, true, true, //
+            false, true, true, true, false, false, false, false, false, false,
+        ];
+        let stances = [
+            u, r, u, u, r, u, g, u, u, u, //
+            u, g, u, u, u, u, u, u, u, u,
+        ];
+        let rock = between_raised(&inside, &stances, 10);
+        let expected = [
+            false, true, true, true, true, false, false, false, false, false, //
+            false, false, false, false, false, false, false, false, false, false,
+        ];
+        assert_eq!(rock, expected);
+    }
+
+    #[test]
+    fn grayscale_panoramas_are_detected_by_luminance() {
+        let grey = image::RgbImage::from_pixel(4, 2, image::Rgb([90, 90, 90]));
+        let mut colour = grey.clone();
+        colour.put_pixel(3, 1, image::Rgb([120, 90, 70]));
+        assert_eq!(Channels::Auto.resolve(&grey), Channels::Luminance);
+        assert_eq!(Channels::Auto.resolve(&colour), Channels::Colour);
+        assert_eq!(Channels::Colour.resolve(&grey), Channels::Colour);
+        assert_eq!(Channels::Luminance.resolve(&colour), Channels::Luminance);
     }
 
     /// A one-pixel crack inside a blob is bridged; the blob does not grow, even at the edge.

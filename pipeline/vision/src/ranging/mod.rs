@@ -205,7 +205,7 @@ fn ground_cue(
     if d.bbox[3] + 1 >= calib.image.height || contact_hidden(index, all, calib.image.width) {
         return None;
     }
-    let near = calib.ground_range(d.contact_row + model.contact_error_px)?;
+    let near = calib.ground_range(d.contact_row + d.contact_slack_rows + model.contact_error_px)?;
     let far = calib.ground_range(d.contact_row - model.contact_error_px)?;
     // Range from the eye along the view, then from the station centre (the eye sits half a
     // baseline across the view).
@@ -336,6 +336,7 @@ mod tests {
             bbox,
             pixels: 100,
             contact_row: f64::from(bbox[3] + 1),
+            contact_slack_rows: 0.0,
             appearance: Appearance {
                 colour: [0.4, 0.33, 0.27],
                 brightness: 0.8,

@@ -3,7 +3,7 @@
 //! cue.
 
 use crate::calib::Calibration;
-use crate::detection::{detect, DetectorSettings};
+use crate::detection::{detect, detect_right, Channels, DetectorSettings};
 use crate::ranging::PrimaryEye;
 use crate::run::StationDetections;
 use crate::survey::{read_image, Station};
@@ -59,11 +59,21 @@ pub fn detect_station(
                 None
             }
         });
+    let channels = settings.channels.resolve(&primary);
+    if channels == Channels::Luminance && right.is_none() {
+        warnings.push(format!(
+            "station {}: a grayscale panorama without its right partner: rocks cannot be told \
+             from cast shadows without stereo, so its detections are not used",
+            station.name
+        ));
+    }
     let start = Instant::now();
     // Only the primary (left) panorama's blobs are separated by parallax: the right one's
     // detections only serve the stereo cue, which separated parts do not take.
     let primary_detections = detect(&primary, right.as_ref(), calib, settings);
-    let right_detections = right.as_ref().map(|r| detect(r, None, calib, settings));
+    let right_detections = right
+        .as_ref()
+        .map(|r| detect_right(r, Some(&primary), calib, settings));
     detect_seconds += start.elapsed().as_secs_f64();
     let mut files = vec![name(&station.primary)];
     if let Some(path) = station.right.as_ref().filter(|_| right.is_some()) {
@@ -79,6 +89,7 @@ pub fn detect_station(
             name: station.name.clone(),
             files,
             eye,
+            channels,
             primary: primary_detections,
             right: right_detections,
             warnings,

@@ -22,6 +22,8 @@ pub struct StationDetections {
     pub name: String,
     pub files: Vec<String>,
     pub eye: PrimaryEye,
+    /// The detector's mode for the primary panorama (`Channels::resolve`).
+    pub channels: crate::detection::Channels,
     pub primary: Vec<Detection>,
     /// Detections of the right panorama of a stereo station.
     pub right: Option<Vec<Detection>>,
@@ -117,6 +119,7 @@ impl<C: Calculus> Mapper<C> {
             index,
             station: station.name.clone(),
             files: station.files.clone(),
+            channels: station.channels,
             warnings: station.warnings.clone(),
             ..StationRecord::default()
         };
@@ -136,6 +139,7 @@ impl<C: Calculus> Mapper<C> {
             .zip(&ranged)
             .map(|(d, r)| detection_record(d, r))
             .collect();
+        record.fusion.usable = usable.len();
         if usable.len() < 3 {
             record.warnings.push(format!(
                 "{}: {} usable detections; a panorama needs at least 3 landmarks to measure",
@@ -416,6 +420,7 @@ fn detection_record(d: &Detection, r: &Ranged) -> DetectionRecord {
         bbox: d.bbox,
         centroid: d.centroid,
         contact_row: d.contact_row,
+        contact_slack_rows: d.contact_slack_rows,
         pixels: d.pixels,
         stereo_column: r.stereo_column,
         bearing: r.bearing.angle,

@@ -13,6 +13,10 @@ pub struct StationRecord {
     pub station: String,
     /// Image files read for this station (left first), relative to the image directory.
     pub files: Vec<String>,
+    /// What told rocks from the ground in its panorama: `colour`, or `luminance` (and stereo
+    /// height) for grayscale panoramas.
+    #[serde(default)]
+    pub channels: crate::detection::Channels,
     /// Detections in the primary (left or mono) panorama, in column order.
     pub detections: Vec<DetectionRecord>,
     /// The asserted "nearer than" pairs `(i, j)`: detection `i` is nearer than detection `j`.
@@ -36,6 +40,10 @@ pub struct DetectionRecord {
     pub centroid: [f64; 2],
     /// Row of the ground contact.
     pub contact_row: f64,
+    /// Rows below `contact_row` the true contact may lie (luminance mode: a rock's lowest rows
+    /// cannot be told from the ground by stereo).
+    #[serde(default)]
+    pub contact_slack_rows: f64,
     pub pixels: u32,
     /// Centroid column of the matched detection in the right panorama, if any.
     pub stereo_column: Option<f64>,
@@ -82,6 +90,9 @@ pub enum Association {
 /// The outcome of fusing one panorama.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct FusionRecord {
+    /// Detections usable for mapping (not doubted by the detector or by ranging).
+    #[serde(default)]
+    pub usable: usize,
     /// Landmarks whose triples were measured.
     pub landmarks: usize,
     /// Triples measured.

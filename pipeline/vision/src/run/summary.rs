@@ -2,6 +2,7 @@
 
 use super::mapper::Mapper;
 use super::record::{Association, StationRecord};
+use crate::detection::Channels;
 use qrm_core::calculus::Calculus;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -11,6 +12,13 @@ pub struct RunSummary {
     pub stations: usize,
     /// Stations whose primary image could not be used.
     pub stations_skipped: usize,
+    /// Stations detected by luminance and stereo height (grayscale panoramas); the others by
+    /// colour.
+    #[serde(default)]
+    pub stations_luminance: usize,
+    /// Stations read, but with fewer than three usable detections: they add nothing.
+    #[serde(default)]
+    pub stations_unusable: usize,
     pub detections: usize,
     pub landmarks: usize,
     pub triples: usize,
@@ -53,6 +61,14 @@ impl RunSummary {
         RunSummary {
             stations: records.len(),
             stations_skipped: skipped,
+            stations_luminance: records
+                .iter()
+                .filter(|r| r.channels == Channels::Luminance)
+                .count(),
+            stations_unusable: records
+                .iter()
+                .filter(|r| !r.files.is_empty() && r.fusion.usable < 3)
+                .count(),
             detections: records.iter().map(|r| r.detections.len()).sum(),
             landmarks: last.landmarks,
             triples: last.triples,
@@ -90,6 +106,25 @@ impl fmt::Display for RunSummary {
             "{} stations ({} skipped), {} detections → {} landmarks, {} triples",
             self.stations, self.stations_skipped, self.detections, self.landmarks, self.triples
         )?;
+        if self.stations_unusable > 0 {
+            writeln!(
+                f,
+                "{} stations had fewer than 3 usable detections and added nothing (warnings in stations.json)",
+                self.stations_unusable
+            )?;
+        }
+        let luminance = self.stations_luminance;
+        match luminance {
+            0 => writeln!(f, "rocks told from the ground by colour")?,
+            n if n == self.stations => writeln!(
+                f,
+                "rocks told from the ground by luminance and stereo height (grayscale panoramas)"
+            )?,
+            n => writeln!(
+                f,
+                "rocks told from the ground by luminance and stereo height at {n} stations (grayscale), by colour at the others"
+            )?,
+        }
         writeln!(
             f,
             "map: {:.1} % of states open, {:.1} % of triples fully constrained; RNG {} certain + {} uncertain edges",
