@@ -132,6 +132,24 @@ impl Survey {
 }
 
 /// Reads one panorama as 8-bit RGB and checks its size against the calibration's.
+/// `image` as 8-bit RGB; an 8-bit grayscale panorama by copying each level to the three
+/// channels (the generic conversion goes through colour-space handling, a quarter of a
+/// grayscale run's time).
+fn into_rgb(image: image::DynamicImage) -> RgbImage {
+    match image {
+        image::DynamicImage::ImageLuma8(grey) => {
+            let (width, height) = grey.dimensions();
+            let raw = grey
+                .into_raw()
+                .into_iter()
+                .flat_map(|v| [v, v, v])
+                .collect();
+            RgbImage::from_raw(width, height, raw).expect("three bytes per pixel")
+        }
+        other => other.into_rgb8(),
+    }
+}
+
 pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageError> {
     let image = image::ImageReader::open(path)
         .map_err(|e| ImageError::Decode {
@@ -147,8 +165,8 @@ pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageEr
         .map_err(|source| ImageError::Decode {
             path: path.to_path_buf(),
             source,
-        })?
-        .into_rgb8();
+        })
+        .map(into_rgb)?;
     if image.dimensions() != expected {
         return Err(ImageError::Size {
             path: path.to_path_buf(),

@@ -60,7 +60,7 @@ struct Args {
 /// detection time per image and, with `truth.json`, the detector's score.
 fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
     use qrm_synth::evaluation::{median_and_max, Detectable, DetectedBox, Score};
-    use qrm_vision::detection::{detect, DetectorSettings};
+    use qrm_vision::detection::{detect, detect_right, DetectorSettings};
     let calib = qrm_vision::calib::Calibration::load(&dir.join("calib.toml"))?;
     let truth: Option<qrm_synth::dataset::Truth> =
         match std::fs::read_to_string(dir.join("truth.json")) {
@@ -83,17 +83,24 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
             .file_name()
             .and_then(|n| n.to_str())
             .unwrap_or_default();
-        let partner = name
-            .strip_suffix("_left.png")
-            .map(|stem| file.with_file_name(format!("{stem}_right.png")))
-            .filter(|p| p.exists());
-        let right = match partner {
-            Some(p) => Some(image::open(p)?.into_rgb8()),
-            None => None,
+        // As in the run: a left image with its right partner, a right one with its left.
+        let partner = |from: &str, to: &str| {
+            name.strip_suffix(from)
+                .map(|stem| file.with_file_name(format!("{stem}{to}")))
+                .filter(|p| p.exists())
         };
+        let (right, left) = (
+            partner("_left.png", "_right.png"),
+            partner("_right.png", "_left.png"),
+        );
+        let open = |p: Option<std::path::PathBuf>| p.map(|p| image::open(p).map(|i| i.into_rgb8()));
+        let (right, left) = (open(right).transpose()?, open(left).transpose()?);
         decode += start.elapsed().as_secs_f64();
         let start = Instant::now();
-        let found = detect(&image, right.as_ref(), &calib, &settings);
+        let found = match &left {
+            Some(left) => detect_right(&image, Some(left), &calib, &settings),
+            None => detect(&image, right.as_ref(), &calib, &settings),
+        };
         detecting.push(start.elapsed().as_secs_f64());
         if let Some(t) = truth
             .as_ref()

@@ -66,6 +66,17 @@ pub struct AssociationSettings {
     pub informative_triples: usize,
     /// Most anchor pairs tested per candidate (the most constrained first).
     pub tested_pairs: usize,
+    /// Registrations that must make a pair for it to anchor, at a station without colour:
+    /// chroma is the descriptor's most telling part, and without it rocks a few decimetres
+    /// apart look alike, so a lone registration anchors a rock whose own landmark is missing
+    /// to its neighbour's (grayscale marsyard seed 7, full resolution: 4 landmarks mixing
+    /// neighbours 0.7–1.5 m apart, 3 unsound relations, with one; none with two).
+    #[serde(default = "default_min_support_without_colour")]
+    pub min_support_without_colour: usize,
+}
+
+fn default_min_support_without_colour() -> usize {
+    2
 }
 
 impl Default for AssociationSettings {
@@ -75,6 +86,7 @@ impl Default for AssociationSettings {
             gate: 5.0,
             informative_triples: 6,
             tested_pairs: 20,
+            min_support_without_colour: default_min_support_without_colour(),
         }
     }
 }
@@ -95,6 +107,8 @@ pub struct Evidence {
 pub struct StationEvidence {
     pub view: StationView,
     pub detections: Vec<Evidence>,
+    /// Whether the detections' appearance holds colour (see [`anchors`]).
+    pub colour: bool,
 }
 
 /// The association decision for one detection.
@@ -125,7 +139,12 @@ pub fn associate<C: Calculus>(
         .map(|e| proposals(e, gallery, settings))
         .collect();
     let registrations = registrations(frames, &placed, &candidates);
-    let mut anchors = anchors(&registrations, &candidates);
+    let min_support = if station.colour {
+        1
+    } else {
+        settings.min_support_without_colour
+    };
+    let mut anchors = anchors(&registrations, &candidates, min_support);
     let candidates = placed_near(candidates, &registrations, &placed);
     drop_inconsistent_anchors(map, view, &mut anchors);
     let anchored: Vec<Sighting> = anchors.iter().map(|a| Sighting::new(a.0, a.1)).collect();
@@ -184,10 +203,12 @@ fn registrations<'f>(
 
 /// The registered correspondences all frames agree on, `(detection, landmark, descriptor
 /// distance)`: a detection or landmark given two different partners by different frames is
-/// left out, and so is a pair that most frames holding its landmark do not make.
+/// left out, and so is a pair that most frames holding its landmark do not make, or that
+/// fewer than `min_support` make.
 fn anchors(
     registrations: &[(&Frame, Registration)],
     candidates: &[Vec<(LandmarkId, f64)>],
+    min_support: usize,
 ) -> Vec<(usize, LandmarkId, f64)> {
     let mut pairs: Vec<(usize, LandmarkId)> = registrations
         .iter()
@@ -213,7 +234,7 @@ fn anchors(
                     && (!frame.accumulated || r.pairs.iter().any(|p| p.0 == i || p.1 == l))
             })
             .count();
-        2 * support > holding
+        2 * support > holding && support >= min_support
     };
     pairs
         .iter()
@@ -496,7 +517,14 @@ mod tests {
                 placed: Some(at(p)),
             })
             .collect();
-        (gallery, StationEvidence { view, detections })
+        (
+            gallery,
+            StationEvidence {
+                view,
+                detections,
+                colour: true,
+            },
+        )
     }
 
     /// Associates the station against `frames` on an empty map with default settings.

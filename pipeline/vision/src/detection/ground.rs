@@ -109,10 +109,11 @@ const SELF_SHIFT: isize = 2;
 fn window_costs(a: &[f32], b: &[f32], width: usize, offset: isize) -> Vec<f32> {
     let rows = a.len() / width;
     let mut column_sums = vec![0f32; width];
+    let start = offset.rem_euclid(width as isize) as usize;
     for (ra, rb) in a.chunks_exact(width).zip(b.chunks_exact(width)) {
-        for (x, sum) in column_sums.iter_mut().enumerate() {
-            let xb = (x as isize + offset).rem_euclid(width as isize) as usize;
-            *sum += (ra[x] - rb[xb]).abs();
+        let shifted = rb[start..].iter().chain(&rb[..start]);
+        for ((sum, p), q) in column_sums.iter_mut().zip(ra).zip(shifted) {
+            *sum += (p - q).abs();
         }
     }
     let area = (rows * (2 * RADIUS + 1)) as f32;
@@ -130,7 +131,7 @@ const SMOOTHING_PX: f32 = 1.0;
 
 /// `band` (rows of `width`) smoothed by a Gaussian of [`SMOOTHING_PX`], wrapping at the seam.
 fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
-    let pad = (4.0 * SMOOTHING_PX).ceil() as usize;
+    let pad = (2.0 * SMOOTHING_PX).ceil() as usize;
     let rows = band.len() / width;
     let padded_width = width + 2 * pad;
     let padded: Vec<f32> = band
@@ -144,7 +145,9 @@ fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
     let blurred = Image::<f32, 1>::new(size, padded)
         .and_then(|src| {
             let mut dst = Image::<f32, 1>::from_size_val(size, 0.0)?;
-            gaussian_blur(&src, &mut dst, (0, 0), (SMOOTHING_PX, SMOOTHING_PX))?;
+            // Two standard deviations either side hold 95 % of the kernel's weight.
+            let taps = 2 * (2.0 * SMOOTHING_PX).ceil() as usize + 1;
+            gaussian_blur(&src, &mut dst, (taps, taps), (SMOOTHING_PX, SMOOTHING_PX))?;
             Ok(dst)
         })
         .expect("a non-empty band and a positive sigma");

@@ -3,7 +3,7 @@
 
 use super::mapper::StationDetections;
 use crate::association::{Evidence, Placed, StationEvidence};
-use crate::detection::{Detection, Separation};
+use crate::detection::{Channels, Detection, Separation};
 use crate::ranging::{self, RangeInterval, Ranged, SensorModel};
 use qrm_core::measurement::{Bearing, RangeOrder, StationView, MAX_BEARING_UNCERTAINTY};
 
@@ -58,6 +58,7 @@ pub(super) fn station_evidence(
                 placed: placed(&ranged[i]),
             })
             .collect(),
+        colour: station.channels == Channels::Colour,
     }
 }
 
