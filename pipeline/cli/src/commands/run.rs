@@ -43,8 +43,8 @@ pub struct RunArgs {
     #[arg(long)]
     pub rrd: bool,
     /// What tells rocks from the ground: `luminance` uses brightness and stereo height only
-    /// (grayscale cameras, and colour that cannot be trusted); `auto` picks it for grayscale
-    /// panoramas and colour otherwise.
+    /// (grayscale cameras, and colour that cannot be trusted: JPEG, strong sensor noise);
+    /// `auto` picks it for grayscale panoramas and JPEG stereo pairs, colour otherwise.
     #[arg(long, value_enum, default_value_t = ChannelsArg::Auto)]
     pub channels: ChannelsArg,
 }

@@ -72,7 +72,9 @@ fn default_luminance_contrast() -> f32 {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Channels {
-    /// Luminance for grayscale panoramas (every pixel's channels equal), colour otherwise.
+    /// Luminance for grayscale panoramas (every pixel's channels equal) and for JPEG files of
+    /// stereo pairs (their chroma is subsampled and quantised: the per-pixel chroma test fires
+    /// on the artefacts), colour otherwise.
     #[default]
     Auto,
     /// Chroma and luminance: rocks are greyer than the red regolith; cast shadows stay red.
@@ -87,8 +89,14 @@ pub enum Channels {
 impl Channels {
     /// The mode `image` is detected in: `Auto` resolved by whether it holds any colour.
     pub fn resolve(self, image: &image::RgbImage) -> Channels {
+        self.resolve_file(image, false)
+    }
+
+    /// [`Channels::resolve`] for an image decoded from a file: `jpeg` if a JPEG one with a
+    /// stereo partner (without stereo, luminance cannot tell rocks from shadows).
+    pub fn resolve_file(self, image: &image::RgbImage, jpeg: bool) -> Channels {
         match self {
-            Channels::Auto if image.pixels().all(|p| p[0] == p[1] && p[1] == p[2]) => {
+            Channels::Auto if jpeg || image.pixels().all(|p| p[0] == p[1] && p[1] == p[2]) => {
                 Channels::Luminance
             }
             Channels::Auto => Channels::Colour,

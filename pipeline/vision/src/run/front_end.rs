@@ -59,11 +59,18 @@ pub fn detect_station(
                 None
             }
         });
-    let channels = settings.channels.resolve(&primary);
+    let channels = settings
+        .channels
+        .resolve_file(&primary, right.is_some() && is_jpeg(&station.primary));
+    let settings = &DetectorSettings {
+        channels,
+        ..settings.clone()
+    };
     if channels == Channels::Luminance && right.is_none() {
         warnings.push(format!(
-            "station {}: a grayscale panorama without its right partner: rocks cannot be told \
-             from cast shadows without stereo, so its detections are not used",
+            "station {}: detected by luminance (a grayscale panorama, or --channels luminance) \
+             without its right partner: rocks cannot be told from cast shadows without stereo, \
+             so its detections are not used",
             station.name
         ));
     }
@@ -97,6 +104,13 @@ pub fn detect_station(
         decode_seconds,
         detect_seconds,
     }
+}
+
+/// Whether `path` names a JPEG file.
+fn is_jpeg(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("jpg") || e.eq_ignore_ascii_case("jpeg"))
 }
 
 /// `NAME_left.EXT`: a left-eye panorama even when its right partner is missing.

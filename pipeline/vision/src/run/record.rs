@@ -14,7 +14,7 @@ pub struct StationRecord {
     /// Image files read for this station (left first), relative to the image directory.
     pub files: Vec<String>,
     /// What told rocks from the ground in its panorama: `colour`, or `luminance` (and stereo
-    /// height) for grayscale panoramas.
+    /// height) for grayscale or JPEG panoramas.
     #[serde(default)]
     pub channels: crate::detection::Channels,
     /// Detections in the primary (left or mono) panorama, in column order.

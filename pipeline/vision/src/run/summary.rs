@@ -12,8 +12,8 @@ pub struct RunSummary {
     pub stations: usize,
     /// Stations whose primary image could not be used.
     pub stations_skipped: usize,
-    /// Stations detected by luminance and stereo height (grayscale panoramas); the others by
-    /// colour.
+    /// Stations detected by luminance and stereo height (grayscale or JPEG panoramas); the
+    /// others by colour.
     #[serde(default)]
     pub stations_luminance: usize,
     /// Stations read, but with fewer than three usable detections: they add nothing.
@@ -118,11 +118,11 @@ impl fmt::Display for RunSummary {
             0 => writeln!(f, "rocks told from the ground by colour")?,
             n if n == self.stations => writeln!(
                 f,
-                "rocks told from the ground by luminance and stereo height (grayscale panoramas)"
+                "rocks told from the ground by luminance and stereo height (grayscale or JPEG panoramas)"
             )?,
             n => writeln!(
                 f,
-                "rocks told from the ground by luminance and stereo height at {n} stations (grayscale), by colour at the others"
+                "rocks told from the ground by luminance and stereo height at {n} stations (grayscale or JPEG), by colour at the others"
             )?,
         }
         writeln!(
