@@ -131,7 +131,6 @@ impl Survey {
     }
 }
 
-/// Reads one panorama as 8-bit RGB and checks its size against the calibration's.
 /// `image` as 8-bit RGB; an 8-bit grayscale panorama by copying each level to the three
 /// channels (the generic conversion goes through colour-space handling, a quarter of a
 /// grayscale run's time).
@@ -150,6 +149,7 @@ fn into_rgb(image: image::DynamicImage) -> RgbImage {
     }
 }
 
+/// Reads one panorama as 8-bit RGB and checks its size against the calibration's.
 pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageError> {
     let image = image::ImageReader::open(path)
         .map_err(|e| ImageError::Decode {

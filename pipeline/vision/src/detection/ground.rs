@@ -20,13 +20,14 @@ use kornia_imgproc::filter::gaussian_blur;
 /// Half-size of the matching window, pixels.
 const RADIUS: usize = 2;
 
-/// A pixel is off the ground when its matching cost exceeds this many times the band's median
-/// cost (most of the band is soil matched at its own shift: the median is the matching noise
-/// of the images, whatever their noise, blur or compression) …
+/// A pixel is textured enough for the test when its cost against itself shifted by
+/// [`SELF_SHIFT`] exceeds this many times the band's median matching cost (most of the band is
+/// soil matched at its own shift: the median is the matching noise of the images, whatever
+/// their noise, blur or compression) …
 const NOISE_MULTIPLE: f32 = 3.0;
 
 /// … and this many luminance levels (of `r + g + b`) per pixel: a noise-free render matches
-/// the ground to a level or two, which no rock face would be told from.
+/// the ground to a level or two, and a texture that faint tells nothing.
 const MIN_COST: f32 = 6.0;
 
 /// A textured pixel is off the ground when its cost at the ground's shift is at least this
@@ -159,16 +160,19 @@ fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
 }
 
 /// The contact row of a rock whose lowest raised pixel row ends at `raised_bottom` (the row
-/// under that pixel), and the rows under it the true contact may lie. The window smears a
-/// rock's mismatch [`RADIUS`] rows onto the ground below it, and the rock's lowest rows match
-/// the ground within the tolerance: its face is `k · b / (mast · focal · column_width)` columns
-/// off the ground's shift `k` rows above its contact.
+/// under that pixel), and the rows under it the true contact may lie ([`contact_doubt`]).
 pub(super) fn contact_of(raised_bottom: f64, calib: &Calibration) -> (f64, f64) {
+    (raised_bottom - RADIUS as f64, contact_doubt(calib))
+}
+
+/// Rows of doubt on a contact found by the test: the window smears a rock's mismatch
+/// [`RADIUS`] rows onto the ground below it, and the rock's lowest rows match the ground
+/// within the tolerance: its face is `k · b / (mast · focal · column_width)` columns off the
+/// ground's shift `k` rows above its contact.
+pub(super) fn contact_doubt(calib: &Calibration) -> f64 {
     let per_row = calib.stereo.baseline_m
         / (calib.mast.height_m * calib.elevation.focal_px * calib.column_width());
-    let hidden = (TOLERANCE_COLUMNS / per_row).ceil();
-    let smear = RADIUS as f64;
-    (raised_bottom - smear, smear + hidden)
+    RADIUS as f64 + (TOLERANCE_COLUMNS / per_row).ceil()
 }
 
 /// The flat ground's stereo shift (columns) at image row `row`; 0 at and above the horizon.
@@ -295,7 +299,7 @@ mod tests {
             hits as f64 / n as f64
         };
         // The rock's upper rows (clear of its contact by the hidden rows) stand up.
-        let (_, hidden) = contact_of(0.0, &calib);
+        let hidden = contact_doubt(&calib);
         let upper = scene.rock.0.start + 2..scene.rock.0.end - hidden as usize;
         let inner = scene.rock.1.start + 3..scene.rock.1.end - 3;
         assert!(share(upper, inner.clone(), Stance::Raised) > 0.9);
@@ -314,6 +318,7 @@ mod tests {
         let calib = calib();
         let (contact, doubt) = contact_of(100.0, &calib);
         assert_eq!(contact, 100.0 - RADIUS as f64);
+        assert_eq!(doubt, contact_doubt(&calib));
         // k rows above its contact a face is k · 0.2 columns off the ground's shift.
         let per_row = 0.3 / (1.5 * 163.0 * calib.column_width());
         assert!((per_row - 0.2).abs() < 0.01, "{per_row}");

@@ -58,8 +58,9 @@ pub struct DetectorSettings {
     /// Which channels tell rock from regolith.
     #[serde(default)]
     pub channels: Channels,
-    /// In luminance mode, a pixel off the flat ground (by stereo) is rock if its luminance
-    /// differs from its row's median by this fraction either way.
+    /// In luminance mode, a pixel whose luminance differs from its row's median by this
+    /// fraction either way is rock if it lies between pixels standing up from the flat ground
+    /// (by stereo) in its row.
     #[serde(default = "default_luminance_contrast")]
     pub luminance_contrast: f32,
 }
@@ -227,8 +228,15 @@ fn detect_in(
     }
     let raw = &image.as_raw()[top * w * 3..];
     let background = row_medians(raw, w);
+    let luminance = settings.channels.resolve(image) == Channels::Luminance;
+    // The other panorama serves parallax separation (a left image's right partner) and, in
+    // luminance mode, the ground test.
     let bands = other
-        .filter(|(o, _)| o.dimensions() == image.dimensions() && calib.stereo.baseline_m > 0.0)
+        .filter(|(o, eye)| {
+            o.dimensions() == image.dimensions()
+                && calib.stereo.baseline_m > 0.0
+                && (luminance || *eye == Eye::Right)
+        })
         .map(|(o, _)| (ground_luminance(image, top), ground_luminance(o, top)));
     // The right camera sees a point turned towards increasing azimuth, the left one away.
     let towards = if calib.column_sign() > 0.0 { 1 } else { -1 };
@@ -236,7 +244,6 @@ fn detect_in(
         Some((_, Eye::Left)) => -towards,
         _ => towards,
     };
-    let luminance = settings.channels.resolve(image) == Channels::Luminance;
     let stances = bands
         .as_ref()
         .filter(|_| luminance)
@@ -277,7 +284,7 @@ fn detect_in(
     };
     // Notch splitting and ambiguity are measured against the contact's doubt.
     let slack = if stances.is_some() {
-        ground::contact_of(0.0, calib).1
+        ground::contact_doubt(calib)
     } else {
         0.0
     };
@@ -536,21 +543,26 @@ fn segment_luminance(
 fn between_raised(inside: &[bool], stances: &[ground::Stance], w: usize) -> Vec<bool> {
     let mut out = vec![false; inside.len()];
     for (y, row) in inside.chunks_exact(w).enumerate() {
-        let mut x = 0;
-        while x < w {
-            if !row[x] {
-                x += 1;
+        // Runs wrap at the seam: the scan starts after a pixel outside, if the row has one.
+        let start = row.iter().position(|&i| !i).map_or(0, |x| x + 1);
+        let at = |k: usize| (start + k) % w;
+        let raised = |k: usize| stances[y * w + at(k)] == ground::Stance::Raised;
+        let mut k = 0;
+        while k < w {
+            if !row[at(k)] {
+                k += 1;
                 continue;
             }
-            let start = x;
-            while x < w && row[x] {
-                x += 1;
+            let begin = k;
+            while k < w && row[at(k)] {
+                k += 1;
             }
-            let raised = |&i: &usize| stances[y * w + i] == ground::Stance::Raised;
-            let first = (start..x).find(raised);
-            let last = (start..x).rev().find(raised);
+            let first = (begin..k).find(|&j| raised(j));
+            let last = (begin..k).rev().find(|&j| raised(j));
             if let (Some(first), Some(last)) = (first, last) {
-                out[y * w + first..=y * w + last].fill(true);
+                for j in first..=last {
+                    out[y * w + at(j)] = true;
+                }
             }
         }
     }

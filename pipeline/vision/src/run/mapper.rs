@@ -192,7 +192,9 @@ impl<C: Calculus> Mapper<C> {
     }
 
     /// The size cue, for landmarks whose width earlier stations bounded (not for parts of a
-    /// blob separated by parallax: see `selection::width_of`).
+    /// blob separated by parallax: see `selection::width_of`; nor for luminance-mode
+    /// detections: the stereo test's window widens every blob by a few columns, far more of
+    /// a distant rock's width than of a near one's, beyond the cue's margin).
     fn apply_size_cue(
         &self,
         station: &StationDetections,
@@ -201,7 +203,8 @@ impl<C: Calculus> Mapper<C> {
     ) {
         for s in &associated.fused {
             let i = associated.usable[s.position];
-            if station.primary[i].separation != Separation::Whole {
+            let d = &station.primary[i];
+            if d.separation != Separation::Whole || d.contact_slack_rows > 0.0 {
                 continue;
             }
             if let Some(width) = self.gallery.profile(s.landmark).and_then(|p| p.width) {

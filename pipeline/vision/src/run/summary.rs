@@ -65,10 +65,7 @@ impl RunSummary {
                 .iter()
                 .filter(|r| r.channels == Channels::Luminance)
                 .count(),
-            stations_unusable: records
-                .iter()
-                .filter(|r| !r.files.is_empty() && r.fusion.usable < 3)
-                .count(),
+            stations_unusable: records.iter().filter(|r| r.fusion.usable < 3).count(),
             detections: records.iter().map(|r| r.detections.len()).sum(),
             landmarks: last.landmarks,
             triples: last.triples,
