@@ -191,22 +191,27 @@ fn stress(seed: u64, scale: f64, dir: &std::path::Path) -> (Variant, Truth) {
     let truth = write_dataset(
         dir,
         &calib,
-        Request {
-            preset: Preset::Stress,
-            seed,
-            counts: Counts {
-                rocks: None,
-                stations: Some(2),
-            },
-            stereo: true,
-            scenery: variant.scenery,
-            capture: variant.capture,
-            encoding: variant.encoding,
-        },
+        two_stations(Preset::Stress, seed, &variant),
         &|| {},
     )
     .unwrap();
     (variant, truth)
+}
+
+/// Two stereo stations of `preset` with `variant`'s scene, camera and encoding.
+fn two_stations(preset: Preset, seed: u64, variant: &Variant) -> Request {
+    Request {
+        preset,
+        seed,
+        counts: Counts {
+            rocks: None,
+            stations: Some(2),
+        },
+        stereo: true,
+        scenery: variant.scenery,
+        capture: variant.capture,
+        encoding: variant.encoding,
+    }
 }
 
 fn same_files(a: &std::path::Path, b: &std::path::Path, truth: &Truth) -> bool {
@@ -274,18 +279,7 @@ fn stress_members_are_reproducible_and_record_their_draws() {
         let layout = write_dataset(
             &dir("layout"),
             &calib,
-            Request {
-                preset: variant.layout,
-                seed,
-                counts: Counts {
-                    rocks: None,
-                    stations: Some(2),
-                },
-                stereo: true,
-                scenery: variant.scenery,
-                capture: variant.capture,
-                encoding: variant.encoding,
-            },
+            two_stations(variant.layout, seed, &variant),
             &|| {},
         )
         .unwrap();

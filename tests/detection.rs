@@ -6,7 +6,7 @@
 //! the main loss of recall in the clustered Mars Yard, the price of sound bearings. With the
 //! right panorama, blobs of a nearer and a farther rock are also separated by parallax.
 
-use qrm_synth::dataset::{visible_rocks, Counts, Preset, Truth};
+use qrm_synth::dataset::{visible_rocks, Counts, Preset, Truth, VisibleRock};
 use qrm_synth::evaluation::{median_and_max, Detectable, DetectedBox, Score};
 use qrm_synth::{render, Eye, World};
 use qrm_vision::calib::Calibration;
@@ -74,6 +74,20 @@ fn check(score: &Score, precision: f64, recall: f64) {
     );
 }
 
+/// The rocks visible in the left panorama at `pose`, and the stereo pair rendered there.
+fn stereo_pair(
+    world: &World,
+    calib: &Calibration,
+    pose: qrm_synth::Pose,
+) -> (Vec<VisibleRock>, image::RgbImage, image::RgbImage) {
+    let left = render(world, calib, pose, Eye::Left);
+    let truth = visible_rocks(world, calib, pose, Eye::Left, &left);
+    let left = image::RgbImage::from_raw(left.width, left.height, left.rgb).unwrap();
+    let right = render(world, calib, pose, Eye::Right);
+    let right = image::RgbImage::from_raw(right.width, right.height, right.rgb).unwrap();
+    (truth, left, right)
+}
+
 /// Scores of `preset`'s `stations` detected alone and with the right panorama.
 fn mono_and_stereo(preset: Preset, stations: &[usize]) -> (Score, Score) {
     let calib = calibration();
@@ -82,12 +96,7 @@ fn mono_and_stereo(preset: Preset, stations: &[usize]) -> (Score, Score) {
     let settings = DetectorSettings::default();
     let (mut mono, mut stereo) = (Score::default(), Score::default());
     for &k in stations {
-        let pose = layout.stations[k];
-        let left = render(&world, &calib, pose, Eye::Left);
-        let truth = visible_rocks(&world, &calib, pose, Eye::Left, &left);
-        let left = image::RgbImage::from_raw(left.width, left.height, left.rgb).unwrap();
-        let right = render(&world, &calib, pose, Eye::Right);
-        let right = image::RgbImage::from_raw(right.width, right.height, right.rgb).unwrap();
+        let (truth, left, right) = stereo_pair(&world, &calib, layout.stations[k]);
         let alone = boxes(&detect(&left, None, &calib, &settings));
         let paired = boxes(&detect(&left, Some(&right), &calib, &settings));
         mono.add(&alone, &truth, &calib, Detectable::of(&settings));
@@ -237,12 +246,7 @@ fn grayscale_stereo_finds_rocks_and_leaves_shadows() {
     let mut score = Score::default();
     let mut contact_short = 0usize;
     for &k in &[0, 17, 33] {
-        let pose = layout.stations[k];
-        let left = render(&world, &calib, pose, Eye::Left);
-        let truth = visible_rocks(&world, &calib, pose, Eye::Left, &left);
-        let left = image::RgbImage::from_raw(left.width, left.height, left.rgb).unwrap();
-        let right = render(&world, &calib, pose, Eye::Right);
-        let right = image::RgbImage::from_raw(right.width, right.height, right.rgb).unwrap();
+        let (truth, left, right) = stereo_pair(&world, &calib, layout.stations[k]);
         assert_eq!(settings.channels.resolve(&left), Channels::Colour);
         let (left, right) = (grayscale(&left), grayscale(&right));
         assert_eq!(settings.channels.resolve(&left), Channels::Luminance);
