@@ -137,7 +137,11 @@ fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
     let padded_width = width + 2 * pad;
     let padded: Vec<f32> = band
         .chunks_exact(width)
-        .flat_map(|row| (0..padded_width).map(move |x| f32::from(row[(x + width - pad) % width])))
+        .flat_map(|row| {
+            (0..padded_width).map(move |x| {
+                f32::from(row[(x as isize - pad as isize).rem_euclid(width as isize) as usize])
+            })
+        })
         .collect();
     let size = ImageSize {
         width: padded_width,
@@ -311,6 +315,16 @@ mod tests {
         let (a, b) = (scene.shadow.1.start, scene.shadow.1.end);
         assert!(share(shaded.clone(), a - 2..a + 2, Stance::Ground) > 0.9);
         assert!(share(shaded, b - 2..b + 2, Stance::Ground) > 0.9);
+    }
+
+    /// A band thinner and narrower than the smoothing kernel and the window is still judged.
+    #[test]
+    fn a_tiny_band_is_judged_without_panic() {
+        let calib = calib();
+        for (w, rows) in [(1usize, 1usize), (3, 2), (8, 3)] {
+            let band: Vec<u16> = (0..w * rows).map(|i| (i * 37 % 300) as u16).collect();
+            assert_eq!(stances(&band, &band, w, 150, &calib, -1).len(), w * rows);
+        }
     }
 
     #[test]
