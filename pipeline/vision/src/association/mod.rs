@@ -107,7 +107,8 @@ pub struct Evidence {
 pub struct StationEvidence {
     pub view: StationView,
     pub detections: Vec<Evidence>,
-    /// Whether the detections' appearance holds colour (see [`anchors`]).
+    /// Whether the detections' appearance holds colour: without it, an anchor needs more
+    /// registrations (`AssociationSettings::min_support_without_colour`).
     pub colour: bool,
 }
 

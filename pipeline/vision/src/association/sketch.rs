@@ -71,7 +71,7 @@ impl Sketch {
     /// Brings station `station`'s fused sightings (placed around it) into the sketch: the
     /// rigid motion that its landmarks already in the sketch fit moves them there (pairs
     /// that do not fit it are left out of the fit; a placement away from its landmark's
-    /// estimate is left out of the update, see [`Sketch::merge`]). A station sharing
+    /// estimate is left out of the update). A station sharing
     /// too few landmarks with the sketch starts a new sketch in its own coordinates once the
     /// old one has not been updated for [`WINDOW`] stations (the rover has lost it); until
     /// then it is left out. Returns whether the sighting entered the sketch.
