@@ -313,6 +313,12 @@ fn a_bad_image_is_skipped_with_a_warning() {
         .save(dir.join("station_003_left.png"))
         .unwrap();
     std::fs::remove_file(dir.join("station_003_right.png")).unwrap();
+    // A 1-bit PNG (its header is all the reader needs to refuse it): the station is skipped.
+    let mut one_bit = b"\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR".to_vec();
+    one_bit.extend(1024u32.to_be_bytes());
+    one_bit.extend(192u32.to_be_bytes());
+    one_bit.extend([1, 0, 0, 0, 0, 0, 0, 0, 0]);
+    std::fs::write(dir.join("station_004_left.png"), one_bit).unwrap();
     // A mono JPEG panorama is read (and, blank, has no rocks).
     image::RgbImage::from_pixel(1024, 192, image::Rgb([150, 110, 80]))
         .save(dir.join("blank.jpg"))
@@ -340,7 +346,11 @@ fn a_bad_image_is_skipped_with_a_warning() {
         err.contains("station_003") && err.contains("at least 3"),
         "{err}"
     );
+    assert!(
+        err.contains("station_004_left.png") && err.contains("1-bit PNG"),
+        "{err}"
+    );
     let summary = json(&out.join("summary.json"));
-    assert_eq!(summary["stations"], 5);
-    assert_eq!(summary["stations_skipped"], 1);
+    assert_eq!(summary["stations"], 4);
+    assert_eq!(summary["stations_skipped"], 2);
 }

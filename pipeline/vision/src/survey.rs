@@ -52,6 +52,8 @@ pub enum ImageError {
         path: PathBuf,
         source: image::ImageError,
     },
+    #[error("{path}: a {bits}-bit PNG: too few levels to tell rocks from the ground (8 or 16 bits per channel needed)")]
+    Depth { path: PathBuf, bits: u8 },
     #[error("{path}: {width}×{height} pixels, but the calibration is for {expected_width}×{expected_height}")]
     Size {
         path: PathBuf,
@@ -131,6 +133,17 @@ impl Survey {
     }
 }
 
+/// The bit depth in a PNG file's header (`IHDR`), if `path` is a PNG file.
+fn png_bit_depth(path: &Path) -> Option<u8> {
+    use std::io::Read;
+    let mut header = [0u8; 26];
+    std::fs::File::open(path)
+        .ok()?
+        .read_exact(&mut header)
+        .ok()?;
+    (header[..8] == *b"\x89PNG\r\n\x1a\n" && header[12..16] == *b"IHDR").then_some(header[24])
+}
+
 /// `image` as 8-bit RGB; an 8-bit grayscale panorama by copying each level to the three
 /// channels (the generic conversion goes through colour-space handling, a quarter of a
 /// grayscale run's time).
@@ -151,7 +164,7 @@ fn into_rgb(image: image::DynamicImage) -> RgbImage {
 
 /// Reads one panorama as 8-bit RGB and checks its size against the calibration's.
 pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageError> {
-    let image = image::ImageReader::open(path)
+    let reader = image::ImageReader::open(path)
         .map_err(|e| ImageError::Decode {
             path: path.to_path_buf(),
             source: image::ImageError::IoError(e),
@@ -160,13 +173,21 @@ pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageEr
         .map_err(|e| ImageError::Decode {
             path: path.to_path_buf(),
             source: image::ImageError::IoError(e),
-        })?
-        .decode()
-        .map_err(|source| ImageError::Decode {
+        })?;
+    let decode_error = |source| ImageError::Decode {
+        path: path.to_path_buf(),
+        source,
+    };
+    // A 1-, 2- or 4-bit panorama decodes to 8 bits, but with 2 to 16 levels the regolith's
+    // shading and a rock's are one: the detector cannot use it. (The PNG decoder expands such
+    // files without saying so; their header does.)
+    if let Some(bits) = png_bit_depth(path).filter(|&b| b < 8) {
+        return Err(ImageError::Depth {
             path: path.to_path_buf(),
-            source,
-        })
-        .map(into_rgb)?;
+            bits,
+        });
+    }
+    let image = reader.decode().map_err(decode_error).map(into_rgb)?;
     if image.dimensions() != expected {
         return Err(ImageError::Size {
             path: path.to_path_buf(),
