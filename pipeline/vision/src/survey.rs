@@ -80,10 +80,7 @@ impl Survey {
         let mut images = Vec::new();
         for entry in std::fs::read_dir(directory).map_err(list_error)? {
             let path = entry.map_err(list_error)?.path();
-            let is_image = path
-                .extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()));
+            let is_image = extension(&path).is_some_and(|e| EXTENSIONS.contains(&e.as_str()));
             if is_image && path.is_file() {
                 images.push(path);
             }
@@ -131,6 +128,18 @@ impl Survey {
             unpaired,
         }
     }
+}
+
+/// The extension of `path`, lower case.
+fn extension(path: &Path) -> Option<String> {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+}
+
+/// Whether `path` names a JPEG file.
+pub fn is_jpeg(path: &Path) -> bool {
+    extension(path).is_some_and(|e| e == "jpg" || e == "jpeg")
 }
 
 /// The bit depth in a PNG file's header (`IHDR`), if `path` is a PNG file.

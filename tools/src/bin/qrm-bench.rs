@@ -73,12 +73,14 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
         .collect();
     files.sort();
     let settings = DetectorSettings::default();
+    let size = (calib.image.width, calib.image.height);
+    let read = |p: &std::path::Path| qrm_vision::survey::read_image(p, size);
     let (mut decode, mut detecting) = (0.0, Vec::new());
     let mut score = Score::default();
     let mut ambiguous = 0;
     for file in &files {
         let start = Instant::now();
-        let image = image::open(file)?.into_rgb8();
+        let image = read(file)?;
         let name = file
             .file_name()
             .and_then(|n| n.to_str())
@@ -93,7 +95,7 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
             partner("_left.png", "_right.png"),
             partner("_right.png", "_left.png"),
         );
-        let open = |p: Option<std::path::PathBuf>| p.map(|p| image::open(p).map(|i| i.into_rgb8()));
+        let open = |p: Option<std::path::PathBuf>| p.map(|p| read(&p));
         let (right, left) = (open(right).transpose()?, open(left).transpose()?);
         decode += start.elapsed().as_secs_f64();
         let start = Instant::now();

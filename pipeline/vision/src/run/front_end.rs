@@ -6,7 +6,7 @@ use crate::calib::Calibration;
 use crate::detection::{detect, detect_right, Channels, DetectorSettings};
 use crate::ranging::PrimaryEye;
 use crate::run::StationDetections;
-use crate::survey::{read_image, Station};
+use crate::survey::{is_jpeg, read_image, Station};
 use std::path::Path;
 use std::time::Instant;
 
@@ -104,13 +104,6 @@ pub fn detect_station(
         decode_seconds,
         detect_seconds,
     }
-}
-
-/// Whether `path` names a JPEG file.
-fn is_jpeg(path: &Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("jpg") || e.eq_ignore_ascii_case("jpeg"))
 }
 
 /// `NAME_left.EXT`: a left-eye panorama even when its right partner is missing.
