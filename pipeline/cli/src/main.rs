@@ -222,7 +222,22 @@ fn run(cli: Cli) -> Result<()> {
     Ok(())
 }
 
+/// Output piped into a reader that stops early (`pipeline tables | head`) ends the process
+/// quietly, as it does `cat`: Rust ignores SIGPIPE, so the next print would panic on the
+/// broken pipe instead. Every command prints only after its files are written.
+#[cfg(unix)]
+fn end_quietly_on_broken_pipe() {
+    // SAFETY: restoring a signal's default disposition at start-up, before any thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+#[cfg(not(unix))]
+fn end_quietly_on_broken_pipe() {}
+
 fn main() -> ExitCode {
+    end_quietly_on_broken_pipe();
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

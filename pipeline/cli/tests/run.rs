@@ -285,6 +285,29 @@ fn fatal_input_errors_exit_2_and_write_nothing() {
             images.display()
         );
     }
+    // An explicit --truth that is missing or not a truth file fails before any work.
+    let not_truth = empty.join("not-truth.json");
+    std::fs::write(&not_truth, b"{").unwrap();
+    for truth in [missing.join("truth.json"), not_truth] {
+        let out = scratch("bad-truth-out");
+        let o = pipeline(&[
+            "run",
+            "--images",
+            DEMO,
+            "--out",
+            arg(&out),
+            "--truth",
+            arg(&truth),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("--truth; nothing was written") && stderr(&o).contains(arg(&truth)),
+            "{}",
+            stderr(&o)
+        );
+        let written: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
+        assert!(written.is_empty(), "{}: wrote {written:?}", truth.display());
+    }
     // An output path that is a file.
     let file = empty.join("a-file");
     std::fs::write(&file, b"x").unwrap();

@@ -39,6 +39,31 @@ fn answers() {
     assert!(stdout(&pipeline(&["tables"])).contains("0 undecided"));
 }
 
+/// A reader that stops early (`pipeline tables | head -0`) ends the process quietly: no panic
+/// on the broken pipe.
+#[cfg(unix)]
+#[test]
+fn a_closed_output_pipe_ends_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pipeline"))
+        .arg("tables")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    // Closing the read end before the binary has started writing breaks the pipe.
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("binary ends");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        o.status.success() || o.status.signal() == Some(libc::SIGPIPE),
+        "{:?}: {stderr}",
+        o.status
+    );
+}
+
 #[test]
 fn bad_input_is_a_clear_error() {
     for (args, needle) in [

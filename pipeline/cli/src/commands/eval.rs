@@ -36,7 +36,8 @@ pub fn run(args: EvalArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| args.truth.with_file_name("calib.toml"));
     let calib = Calibration::load(&calib_path)?;
-    score_run_files(&args.run, &args.truth, &calib, &out)
+    print_report(&score_run_files(&args.run, &args.truth, &calib, &out)?);
+    Ok(())
 }
 
 fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
@@ -46,14 +47,20 @@ fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
         .with_context(|| format!("{} is not a valid file of its kind", path.display()))
 }
 
+/// Reads and parses a truth file: `pipeline run` checks an explicit `--truth` before any
+/// work, so that a bad one fails with nothing written.
+pub fn read_truth(path: &Path) -> Result<Truth> {
+    read(path)
+}
+
 /// Scores the run in `run_dir` against `truth_path`, writing `eval.json` into `out`.
 pub fn score_run_files(
     run_dir: &Path,
     truth_path: &Path,
     calib: &Calibration,
     out: &Path,
-) -> Result<()> {
-    let truth: Truth = read(truth_path)?;
+) -> Result<Evaluation> {
+    let truth = read_truth(truth_path)?;
     let records: Vec<StationRecord> = read(&run_dir.join("stations.json"))?;
     let landmarks: Vec<LandmarkRecord> = read(&run_dir.join("landmarks.json"))?;
     let map_path = run_dir.join("map.json");
@@ -83,11 +90,10 @@ pub fn score_run_files(
         &out.join("eval.json"),
         (serde_json::to_string_pretty(&eval)? + "\n").as_bytes(),
     )?;
-    print_report(&eval);
-    Ok(())
+    Ok(eval)
 }
 
-fn print_report(e: &Evaluation) {
+pub fn print_report(e: &Evaluation) {
     let d = &e.detection;
     println!("evaluation against truth:");
     println!(

@@ -93,6 +93,9 @@ fn info<C: Calculus>(map: &Hypergraph<C>, rng_out: Option<&Path>) -> Result<()> 
     }
     match (estimate(map), rng_out) {
         (Some(rng), out) => {
+            if let Some(path) = out {
+                write_atomic(path, super::rng_json(map, &rng).as_bytes())?;
+            }
             println!(
                 "RNG estimate: {} edges ({} certain), {} pairs pruned, total cost {:.4}",
                 rng.edges.len(),
@@ -101,7 +104,6 @@ fn info<C: Calculus>(map: &Hypergraph<C>, rng_out: Option<&Path>) -> Result<()> 
                 rng.total_cost()
             );
             if let Some(path) = out {
-                write_atomic(path, super::rng_json(map, &rng).as_bytes())?;
                 println!("wrote {}", path.display());
             }
         }

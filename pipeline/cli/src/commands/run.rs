@@ -154,6 +154,9 @@ pub fn run(args: RunArgs) -> Result<()> {
     let started = Instant::now();
     let survey = Survey::open(&args.images)?;
     let calib = load_calibration(&args)?;
+    if let Some(truth) = args.truth.as_deref().filter(|_| !args.no_eval) {
+        super::eval::read_truth(truth).context("--truth; nothing was written")?;
+    }
     for path in &survey.unpaired {
         eprintln!(
             "warning: {} has no _left partner and is not used",
@@ -189,15 +192,24 @@ pub fn run(args: RunArgs) -> Result<()> {
         &args.out.join("summary.json"),
         (serde_json::to_string_pretty(&summary)? + "\n").as_bytes(),
     )?;
-    print_summary(&summary, &args.out, started);
     let truth = args.truth.clone().or_else(|| {
         let default = args.images.join("truth.json");
         default.exists().then_some(default)
     });
-    match (truth, args.no_eval) {
-        (Some(truth), false) => super::eval::score_run_files(&args.out, &truth, &calib, &args.out)?,
+    let evaluation = match (truth, args.no_eval) {
+        (Some(truth), false) => Some(super::eval::score_run_files(
+            &args.out, &truth, &calib, &args.out,
+        )?),
         // A scoring left from an earlier run into the same directory would not be this run's.
-        _ => remove_stale(&args.out.join("eval.json"))?,
+        _ => {
+            remove_stale(&args.out.join("eval.json"))?;
+            None
+        }
+    };
+    // Printed once every file is written: a reader that stops early ends the process.
+    print_summary(&summary, &args.out, started);
+    if let Some(evaluation) = &evaluation {
+        super::eval::print_report(evaluation);
     }
     Ok(())
 }

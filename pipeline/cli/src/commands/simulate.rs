@@ -361,6 +361,7 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create directory {}", args.out.display()))?;
     // The picture is the only output that can fail on the data, so it goes first.
+    let mut rng_line = None;
     if let Some(rng) = estimate(&map) {
         let landmarks: Vec<(f64, f64)> = map
             .landmarks()
@@ -398,16 +399,20 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
             &args.out.join("rng.json"),
             super::rng_json(&map, &rng).as_bytes(),
         )?;
-        println!(
+        rng_line = Some(format!(
             "RNG: {} edges kept ({} certain), {} pruned; true RNG has {} edges",
             rng.edges.len(),
             rng.certain().count(),
             rng.pruned,
             true_edges.len()
-        );
+        ));
     }
     write_atomic(&args.out.join("steps.csv"), csv.as_bytes())?;
     write_atomic(&args.out.join("map.json"), map.to_json().as_bytes())?;
+    // Printed once every file is written: a reader that stops early ends the process.
+    if let Some(line) = rng_line {
+        println!("{line}");
+    }
     let last = steps.last().expect("at least one station");
     println!(
         "{} map of {} landmarks after {} images in {:.2} s: {:.1}% incorrect states removed, {:.1}% triples fully constrained, {} unsound relations, {} contradictions",
