@@ -197,9 +197,11 @@ fn maps_grayscale_and_jpeg_surveys_by_luminance() {
         let summary = json(&out.join("summary.json"));
         assert_eq!(summary["stations_luminance"], 16, "{summary}");
         let eval = json(&out.join("eval.json"));
-        // Measured: 102 (grayscale) and 94 (JPEG) sightings, accuracy 0.99 and 1.0.
+        // Measured: 55 (grayscale) and 61 (JPEG) sightings, accuracy 1.0 for both. (102 and
+        // 94 before registration left out loose placements and landmarks seen towards
+        // unused detections, at accuracy 0.99 and 1.0 on a looser map.)
         assert!(
-            eval["association"]["sightings"].as_u64().unwrap() >= 60,
+            eval["association"]["sightings"].as_u64().unwrap() >= 40,
             "{name}: {eval}"
         );
         assert!(

@@ -59,6 +59,12 @@ const SLACK_M: f64 = 0.3;
 const UNIQUE: f64 = 2.0;
 /// How much better (in fit score) the best motion must be than any different one.
 const MARGIN: f64 = 1.5;
+/// Loosest placement of a detection that a registration pairs, metres: a looser one (a far
+/// rock's range interval spans metres) reaches past its own rock, when that has no landmark
+/// yet, to a neighbour's landmark, which is then the only one near and looks unambiguous
+/// (marsyard seed 5: a rock 15.8 m away, placed within 6 m, paired at five stations with a
+/// landmark 2.7 m from it, 2 unsound relations).
+const ANCHOR_RADIUS_M: f64 = 2.0;
 /// Fewest correspondences a registration must explain to be believed.
 const MIN_INLIERS: usize = 4;
 
@@ -190,6 +196,7 @@ fn unambiguous(
             let d = gap(i, j);
             let (p, q) = (current[i].expect("placed"), frame.landmarks[j].1);
             d <= p.radius + q.radius + SLACK_M
+                && p.radius <= ANCHOR_RADIUS_M
                 && (0..frame.landmarks.len()).all(|k| k == j || gap(i, k) > UNIQUE * d + SLACK_M)
                 && placed
                     .iter()
@@ -201,6 +208,37 @@ fn unambiguous(
 }
 
 impl Registration {
+    /// Drops the pairs whose landmark, brought back into the current station by the motion,
+    /// lies in a direction nearer to one of the station's detections without a placement
+    /// (bearings `elsewhere`) than to its paired detection's: the landmark may be that rock
+    /// (on half-resolution marsyard seed 4, a rock 1.8 m from a landmark's, seen while the
+    /// landmark's own rock was detected but touching another, took the landmark at three
+    /// stations: 2 unsound relations).
+    pub fn drop_pairs_seen_elsewhere(
+        &mut self,
+        frame: &Frame,
+        placed: &[Option<Placed>],
+        elsewhere: &[f64],
+    ) {
+        let direction = |p: [f64; 2]| p[1].atan2(p[0]);
+        let apart = |a: f64, b: f64| {
+            let d = (a - b).rem_euclid(std::f64::consts::TAU);
+            d.min(std::f64::consts::TAU - d)
+        };
+        let [cos, sin, x, y] = self.motion;
+        self.pairs.retain(|&(i, l)| {
+            let (Some(p), Some((_, q))) = (placed[i], frame.landmarks.iter().find(|m| m.0 == l))
+            else {
+                return true;
+            };
+            // The inverse motion: rotate back the landmark's offset from the shift.
+            let (dx, dy) = (q.point[0] - x, q.point[1] - y);
+            let back = direction([cos * dx + sin * dy, -sin * dx + cos * dy]);
+            let own = apart(back, direction(p.point));
+            elsewhere.iter().all(|&b| apart(back, b) >= own)
+        });
+    }
+
     /// Where the current station's point `p` lies in the frame's coordinates.
     pub fn to_frame(&self, p: [f64; 2]) -> [f64; 2] {
         let [cos, sin, x, y] = self.motion;
@@ -382,6 +420,51 @@ pub(super) mod tests {
             .map(|(i, &k)| (i, k as LandmarkId + 10))
             .collect();
         assert_eq!(pairs, expected);
+    }
+
+    #[test]
+    fn a_loosely_placed_detection_is_not_paired() {
+        // The field without motion, one more detection placed within 3 m (a far rock's range
+        // interval) around where landmark 16 lies: it helps no motion and pairs with nothing,
+        // though landmark 16 is the only one near.
+        let place = |point: [f64; 2], radius: f64| Placed { point, radius };
+        let frame = Frame {
+            accumulated: false,
+            landmarks: FIELD
+                .iter()
+                .chain(&[[12.0, -12.0]])
+                .enumerate()
+                .map(|(k, &p)| (k as LandmarkId + 10, place(p, 0.2)))
+                .collect(),
+        };
+        let mut current: Vec<Option<Placed>> = FIELD.iter().map(|&p| Some(place(p, 0.2))).collect();
+        current.push(Some(place([13.5, -13.0], 3.0)));
+        let registration =
+            register(&current, &frame, &|_, _| true, &|_, _| true).expect("registers");
+        let mut pairs = registration.pairs.clone();
+        pairs.sort_unstable();
+        let expected: Vec<(usize, LandmarkId)> =
+            (0..6).map(|i| (i, i as LandmarkId + 10)).collect();
+        assert_eq!(pairs, expected);
+    }
+
+    #[test]
+    fn a_pair_whose_landmark_lies_towards_an_unplaced_detection_is_dropped() {
+        // Identity motion. Detection 0 is placed 0.6 m to the left of landmark 10, and an
+        // unplaced detection looks straight at it: the landmark may be that rock. Detection 1
+        // is where landmark 11 lies, nearer in direction than any unplaced detection.
+        let place = |point: [f64; 2]| Placed { point, radius: 0.2 };
+        let frame = Frame {
+            accumulated: false,
+            landmarks: vec![(10, place([3.0, 1.0])), (11, place([5.0, -2.0]))],
+        };
+        let placed = [Some(place([3.0, 1.6])), Some(place([5.0, -2.0]))];
+        let mut registration = Registration {
+            pairs: vec![(0, 10), (1, 11)],
+            motion: [1.0, 0.0, 0.0, 0.0],
+        };
+        registration.drop_pairs_seen_elsewhere(&frame, &placed, &[1f64.atan2(3.0), 2.0]);
+        assert_eq!(registration.pairs, vec![(1, 11)]);
     }
 
     #[test]

@@ -59,6 +59,10 @@ pub(super) fn station_evidence(
             })
             .collect(),
         colour: station.channels == Channels::Colour,
+        unused_bearings: (0..ranged.len())
+            .filter(|i| !usable.contains(i))
+            .map(|i| ranged[i].bearing.angle)
+            .collect(),
     }
 }
 
