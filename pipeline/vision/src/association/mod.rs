@@ -6,7 +6,9 @@
 //! 2. **anchors** are the unambiguous correspondences of the rigid motion that best lines up
 //!    the station's look-alike detections with a recent station's landmarks, or with the
 //!    [`Sketch`] of all recently seen landmarks ([`register`]);
-//!    the motion also rules out the frame's landmarks that lie away from a detection. An
+//!    the motion also rules out the frame's landmarks that lie away from a detection. A
+//!    detection placed looser than 2 m pairs with nothing, and a pair whose landmark lies in
+//!    the direction of a detection mapping does not use is dropped (it may be that rock). An
 //!    anchor must be paired so by most registered frames that hold its landmark, and anchors
 //!    are checked against each other: a triple of anchors whose measured states do not
 //!    overlap the map's is inconsistent, and the anchor in most such triples is dropped until
@@ -14,9 +16,11 @@
 //! 3. every other proposal is tested as 000 §VI-C describes: the detection's triples with
 //!    pairs of anchors are measured and compared with the candidate landmark's relations in
 //!    the map; a candidate with an empty overlap in any relation is rejected;
-//! 4. no candidate left → a new landmark; otherwise the observation is **held back** and
-//!    tried again when the map is tighter, where it becomes a new landmark once every
-//!    candidate has been rejected. Nothing is fused on a guess.
+//! 4. no candidate left → a new landmark, unless the motion places the detection where a
+//!    landmark lies that no detection is anchored to (likely a piece or a lit face of that
+//!    rock), which then becomes its candidate. With candidates, the observation is **held
+//!    back** and tried again when the map is tighter, where it becomes a new landmark once
+//!    every candidate has been rejected. Nothing is fused on a guess.
 //!
 //! Why a lone surviving candidate is not matched at once: a rejection is sound evidence (the
 //! map and the measurement exclude each other), a pass is not, since a loose map lets most
@@ -175,7 +179,7 @@ pub fn associate<C: Calculus>(
                 // station is anchored to lies where the detection is: most likely its own
                 // rock, seen so differently (a piece of it, a lit face) that its looks did
                 // not propose it. A new landmark would duplicate it (marsyard seed 3: two
-                // rocks duplicated, 10 points of removed states lost); the map decides later.
+                // rocks duplicated, 37 points of removed states lost); the map decides later.
                 // (Counting a look-alike of another detection as accounted for brought the
                 // duplicates back.)
                 let unaccounted = placed[i]
@@ -630,8 +634,8 @@ mod tests {
     #[test]
     fn a_detection_where_an_unaccounted_landmark_lies_is_not_new() {
         // Detection 6 looks like no landmark (a piece of a rock, a lit face), but the motion
-        // puts it where landmark 6 lies, which no other detection is or may be: a new
-        // landmark would duplicate it. Away from every landmark, detection 7 is new.
+        // puts it where landmark 6 lies, which no detection is anchored to: a new landmark
+        // would duplicate it. Away from every landmark, detection 7 is new.
         let mut points = FIELD.to_vec();
         points.extend([[-1.0, 9.0], [4.0, -9.0]]);
         let mut station = station(&points);
