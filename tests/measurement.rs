@@ -208,7 +208,7 @@ fn sweep_agrees_with_branch_and_bound() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(300))]
+    #![proptest_config(ProptestConfig::with_cases(2000))]
 
     /// Turning every bearing by the same angle (the rover's heading, the calibration's zero
     /// column) measures the same relations, exact or uncertain bearings alike. Before the
@@ -256,6 +256,56 @@ fn a_turned_triple_is_measured_as_tightly() {
         let view = StationView::new(bearings, order.clone()).unwrap();
         let measured = view.measure_triple::<Edc>([0, 1, 2], [Edc::universe(); 3]);
         assert_eq!(measured, expected, "turned by {turn}°");
+    }
+}
+
+/// Triples `measurement_is_rotation_invariant` found turned into a region no arrangement
+/// reaches (brute-force sampling finds none), with `B < C`: the sweep sampled A 10⁻¹⁴ from the
+/// camera, the gap of a critical range that is the rounding noise of 0, and once `|B| = |C|`
+/// itself (a root one ulp below that bound, the midpoint rounded onto it). Each must be
+/// measured alike at both turns, without the region.
+#[test]
+fn rounding_never_adds_a_region_at_some_turn() {
+    // (bearings, turn, relation index, the region no arrangement reaches)
+    let cases = [
+        (
+            [
+                1.272_498_744_241_629_1,
+                1.172_409_068_834_943_1,
+                1.150_217_160_080_785_6,
+            ],
+            3.428_433_498_477_577_5,
+            2,
+            15,
+        ),
+        (
+            [
+                2.671_864_395_016_084_5,
+                3.786_051_978_605_433,
+                1.554_329_258_216_057_5,
+            ],
+            6.103_367_669_562_196,
+            2,
+            2,
+        ),
+    ];
+    let order = RangeOrder::from_pairs(3, &[(1, 2)]).unwrap();
+    for (angles, turn, relation, region) in cases {
+        let measure = |turn: f64| {
+            let bearings = angles
+                .iter()
+                .map(|a| Bearing::exact((a + turn).rem_euclid(std::f64::consts::TAU)))
+                .collect();
+            let view = StationView::new(bearings, order.clone()).unwrap();
+            view.measure_triple::<Edc>([0, 1, 2], [Edc::universe(); 3])
+        };
+        let unturned = measure(0.0);
+        let turned = measure(turn);
+        assert_eq!(turned, unturned, "{angles:?} turned by {turn}");
+        assert!(
+            !unturned[relation].contains(region),
+            "{angles:?}: {unturned:?}"
+        );
     }
 }
 

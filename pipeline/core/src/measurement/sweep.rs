@@ -86,6 +86,15 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
     found.intersection(wanted)
 }
 
+/// Range ratios the sweep resolves. A critical value or root beyond `[10⁻¹², 10¹²]` is the
+/// rounding noise of one at 0 or ∞ (a vertex equation or boundary value that cancels to an ulp):
+/// its gap would be sampled with a landmark 10⁻¹⁴ from the camera, where terms of that size
+/// drown in the classification tolerance and a region no arrangement reaches is classified in
+/// (region 2 of `CA:B` at bearings 153.09°, 216.92°, 89.06° with `B < C`, found by the
+/// rotation-invariance property test). Such values are dropped, so the gap merges with its
+/// neighbour and is sampled at a resolvable ratio.
+const RESOLVED_RATIO: f64 = 1e12;
+
 /// Ratios `|B| / |A|` tried before the exact sweep.
 const PROBE_RANGES: [f64; 6] = [0.3, 0.6, 0.9, 1.1, 1.6, 3.0];
 
@@ -159,25 +168,25 @@ fn critical_ranges(u: [Point; 3], functions: &BoundaryPolynomials) -> Vec<f64> {
 }
 
 /// A point inside every gap between the sorted `points` within `(lo, hi)`, including the end
-/// gaps. Every gap is sampled, however narrow: a narrow gap may be a genuine sliver of a region
+/// gaps. Every gap that holds an `f64` is sampled, however narrow: a narrow gap may be a genuine sliver of a region
 /// (e.g. the cusp between circle B and the perpendicular at A, both through A, is ε² wide on a
 /// ray ε from A's bearing), and a sample that falls on a boundary in rounding is classified
 /// into both neighbours by [`BoundaryPolynomials::regions_at`].
 fn gap_samples(points: &mut Vec<f64>, lo: f64, hi: f64) -> Vec<f64> {
-    points.retain(|&x| x > lo && x < hi);
+    points.retain(|&x| x > lo && x < hi && (1.0 / RESOLVED_RATIO..=RESOLVED_RATIO).contains(&x));
     points.sort_by(f64::total_cmp);
     points.dedup();
     let mut samples = Vec::with_capacity(points.len() + 1);
     let mut last = lo;
     for &x in points.iter() {
-        samples.push(inside(last, x));
+        samples.extend(inside(last, x));
         last = x;
     }
-    samples.push(if hi.is_finite() {
-        inside(last, hi)
+    if hi.is_finite() {
+        samples.extend(inside(last, hi));
     } else {
-        2.0 * last.max(1.0)
-    });
+        samples.push(2.0 * last.max(1.0));
+    }
     samples
 }
 
@@ -185,12 +194,18 @@ fn gap_samples(points: &mut Vec<f64>, lo: f64, hi: f64) -> Vec<f64> {
 /// a factor 2 from both ends: the landmarks' ranges are then of comparable size, and a gap that
 /// ends at a huge (often spurious) critical value is not sampled where the nearer landmarks
 /// vanish in rounding.
-fn inside(a: f64, b: f64) -> f64 {
-    if a > 0.0 && b > 4.0 * a {
+///
+/// `None` when no `f64` lies strictly between the ends: a sample rounded onto an end would sit
+/// on a root or on a bound of the range order (`|C| = |A|`), where rounding classifies regions
+/// the open interval never reaches (region 15 of `CA:B` at bearings 72.91°, 67.17°, 65.90°
+/// with `B < C`, turned by 196.4°).
+fn inside(a: f64, b: f64) -> Option<f64> {
+    let x = if a > 0.0 && b > 4.0 * a {
         1.0f64.clamp(2.0 * a, 0.5 * b)
     } else {
         0.5 * (a + b)
-    }
+    };
+    (x > a && x < b).then_some(x)
 }
 
 /// Appends the positive real roots of `a·x² + b·x + c` (a linear or constant polynomial when
