@@ -135,14 +135,13 @@ fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
     let pad = (2.0 * SMOOTHING_PX).ceil() as usize;
     let rows = band.len() / width;
     let padded_width = width + 2 * pad;
-    let padded: Vec<f32> = band
-        .chunks_exact(width)
-        .flat_map(|row| {
-            (0..padded_width).map(move |x| {
-                f32::from(row[(x as isize - pad as isize).rem_euclid(width as isize) as usize])
-            })
-        })
-        .collect();
+    let mut padded: Vec<f32> = Vec::with_capacity(padded_width * rows);
+    for row in band.chunks_exact(width) {
+        let wrapped = |k: usize| f32::from(row[k % width]);
+        padded.extend((0..pad).map(|k| wrapped(k + pad * width - pad)));
+        padded.extend(row.iter().map(|&v| f32::from(v)));
+        padded.extend((0..pad).map(wrapped));
+    }
     let size = ImageSize {
         width: padded_width,
         height: rows,
@@ -156,11 +155,11 @@ fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
             Ok(dst)
         })
         .expect("a non-empty band and a positive sigma");
-    blurred
-        .as_slice()
-        .chunks_exact(padded_width)
-        .flat_map(|row| row[pad..pad + width].iter().copied())
-        .collect()
+    let mut out = Vec::with_capacity(width * rows);
+    for row in blurred.as_slice().chunks_exact(padded_width) {
+        out.extend_from_slice(&row[pad..pad + width]);
+    }
+    out
 }
 
 /// The contact row of a rock whose lowest raised pixel row ends at `raised_bottom` (the row

@@ -8,14 +8,17 @@
 //! much brighter; cast shadows are darker but keep the regolith's red hue, so they are left out
 //! and cannot drag the contact row or centroid. Small blobs are rejected by physical width at
 //! the flat-ground range of their contact row, which removes pebbles at every resolution.
+//! With a stereo partner, pixels standing up from the ground that join a blob bound how far
+//! its rock may reach beyond what the colour test found (`extent`).
 
 mod components;
+mod extent;
 mod ground;
 mod parallax;
 mod split;
 
 use crate::calib::Calibration;
-use components::{blob_of, label_wrapped, Blob};
+use components::{blob_of, bounds, label_wrapped, Blob};
 use kornia_image::{Image, ImageSize};
 pub use parallax::{ParallaxRule, Separation};
 use serde::{Deserialize, Serialize};
@@ -163,6 +166,12 @@ pub struct Detection {
     /// The connected blob of the mask this detection was cut from: pieces of one blob share it.
     #[serde(default)]
     pub blob: u32,
+    /// Columns before and after `bbox` over which the rock may reach: pixels standing up from
+    /// the ground (by stereo) that join the blob where this piece ends it. The colour test
+    /// can find only part of a rock nearly the soil's colour (`extent`); 0 for a piece whose
+    /// blob ends where the raised pixels do.
+    #[serde(default)]
+    pub beyond_columns: [u32; 2],
 }
 
 /// Statistics that change little with viewpoint, for associating a rock across panoramas.
@@ -229,8 +238,8 @@ fn detect_in(
     let raw = &image.as_raw()[top * w * 3..];
     let background = row_medians(raw, w);
     let luminance = settings.channels.resolve(image) == Channels::Luminance;
-    // The other panorama serves parallax separation (a left image's right partner) and, in
-    // luminance mode, the ground test.
+    // The other panorama serves parallax separation and the rocks' extents (a left image's
+    // right partner) and, in luminance mode, the ground test.
     let bands = other
         .filter(|(o, eye)| {
             o.dimensions() == image.dimensions()
@@ -307,8 +316,10 @@ fn detect_in(
         column_width: calib.column_width(),
         baseline_m: calib.stereo.baseline_m,
     });
-    let mut detections: Vec<Detection> = label_wrapped(&mask, w, rows)
-        .into_iter()
+    let blobs = label_wrapped(&mask, w, rows);
+    let mut detections: Vec<Detection> = blobs
+        .iter()
+        .cloned()
         .enumerate()
         .flat_map(|(blob, c)| {
             let layers = match &partner {
@@ -347,9 +358,47 @@ fn detect_in(
             Some(detection)
         })
         .collect();
+    // In colour mode, how far each detected blob's rock may reach beyond what the colour test
+    // found; a piece reaches beyond its blob only on the sides where it ends the blob.
+    if let Some((own, other)) = bands
+        .as_ref()
+        .filter(|_| !luminance && !detections.is_empty())
+    {
+        let stances = ground::stances(own, other, w, top, calib, direction);
+        let raised = |c: i64, r: i64| {
+            stances[r as usize * w + c.rem_euclid(w as i64) as usize] == ground::Stance::Raised
+        };
+        let mut reach = std::collections::HashMap::new();
+        for detection in &mut detections {
+            let blob = &blobs[detection.blob as usize];
+            let Some(b) = bounds(blob) else {
+                continue;
+            };
+            let [before, after] = *reach.entry(detection.blob).or_insert_with(|| {
+                let limits = (
+                    REACH_WIDTHS * (b[2] - b[0] + 1),
+                    REACH_HEIGHTS * (b[3] - b[1] + 1),
+                );
+                extent::beyond(blob, mask.as_slice(), w, rows, limits, raised)
+            });
+            detection.beyond_columns = [
+                if detection.bbox[0] == b[0] { before } else { 0 },
+                if detection.bbox[2] == b[2] { after } else { 0 },
+            ];
+        }
+    }
     detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
     detections
 }
+
+/// Raised pixels more than this many of a blob's widths beyond it are not taken for more of
+/// its rock (a neighbour the colour test missed, or ground the stereo test mismatched): the
+/// smallest piece seen of a rock is a quarter of its width (stress member 5, `extent`).
+const REACH_WIDTHS: u32 = 3;
+
+/// … nor raised pixels more than this many of its heights above it, or below its contact
+/// (the piece of stress member 5 is half its rock's height, and on the ground).
+const REACH_HEIGHTS: u32 = 2;
 
 /// How a pixel is told to be rock.
 enum PixelRule<'a> {
@@ -654,6 +703,7 @@ fn accept(
         ambiguous,
         separation: Separation::Whole,
         blob: 0,
+        beyond_columns: [0, 0],
     })
 }
 

@@ -292,8 +292,18 @@ fn bearing_of(
     range: RangeInterval,
 ) -> Bearing {
     let left = calib.azimuth(d.centroid[0]);
-    let error = (model.bearing_error_px + model.bearing_error_per_width * apparent_columns(d))
-        * calib.column_width();
+    let columns = model.bearing_error_px + model.bearing_error_per_width * apparent_columns(d);
+    // Where the rock's centre may lie off the centroid, in columns: within the centroid's
+    // error, or within a column's error of the centre of a span the rock may cover. The
+    // right eye's piece of a stereo pair is taken to be the same part of the rock (the same
+    // colour test on nearly the same view), so its centroid is off by as much.
+    let (low, high) = centre_offsets(d, f64::from(calib.image.width));
+    let (low, high) = (
+        (low - model.bearing_error_px).min(-columns),
+        (high + model.bearing_error_px).max(columns),
+    );
+    let shift = 0.5 * (low + high) * calib.column_sign() * calib.column_width();
+    let error = 0.5 * (high - low) * calib.column_width();
     let (angle, spread) = match right {
         Some(r) => {
             let difference = azimuth_difference(calib.azimuth(r.centroid[0]), left);
@@ -307,9 +317,31 @@ fn bearing_of(
         None => (left, 0.0),
     };
     Bearing {
-        angle: angle.rem_euclid(TAU),
+        angle: (angle + shift).rem_euclid(TAU),
         uncertainty: error + spread,
     }
+}
+
+/// Columns, relative to the centroid, between which the centre of the rock a piece belongs to
+/// may lie: the rock holds the piece's columns and stays within
+/// [`Detection::beyond_columns`] of them, so its centre lies between the centres of the
+/// narrowest and the widest such spans; the centroid itself is kept inside. `(0, 0)` for a
+/// piece with nothing beyond it.
+fn centre_offsets(d: &Detection, width: f64) -> (f64, f64) {
+    let [before, after] = d.beyond_columns.map(f64::from);
+    if before == 0.0 && after == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (first, end) = (f64::from(d.bbox[0]), f64::from(d.bbox[2]) + 1.0);
+    // The centroid in the bbox's unwrapped columns.
+    let centroid = if d.centroid[0] < first {
+        d.centroid[0] + width
+    } else {
+        d.centroid[0]
+    };
+    let low = 0.5 * (first - before + end) - centroid;
+    let high = 0.5 * (first + end + after) - centroid;
+    (low.min(0.0), high.max(0.0))
 }
 
 /// `a − b` wrapped into `(−π, π]`.
@@ -346,6 +378,7 @@ mod tests {
             ambiguous: separation == Separation::Farther,
             separation,
             blob: 7,
+            beyond_columns: [0, 0],
         }
     }
 
@@ -383,6 +416,35 @@ mod tests {
             touches_neighbour(0, &strangers, width),
             "a farther part of another blob"
         );
+    }
+
+    /// Stress member 5's piece: columns 68–74 of a rock whose visible columns are 68–93, the
+    /// raised pixels beside it reaching 19 columns further. The bearing keeps the piece's
+    /// centroid and takes in the rock's centre; a piece with nothing beyond keeps its bearing.
+    #[test]
+    fn a_piece_with_raised_pixels_beyond_it_is_widened_to_the_rock() {
+        let calib = Calibration::parse(
+            "[image]\nwidth = 2048\nheight = 384\n[azimuth]\ncolumn0_deg = 102.0\n\
+             direction = \"clockwise\"\n[elevation]\nhorizon_row = 150.0\nfocal_px = 326.0\n\
+             [mast]\nheight_m = 1.5\n[stereo]\nbaseline_m = 0.3\n",
+            "test",
+        )
+        .expect("valid");
+        let model = SensorModel::default();
+        let range = RangeInterval::new(4.0, 5.0);
+        let mut piece = blob([68, 222, 74, 228], Separation::Whole);
+        piece.centroid[0] = 71.3;
+        let alone = bearing_of(&piece, None, &calib, &model, 0.0, range);
+        piece.beyond_columns = [0, 19];
+        let widened = bearing_of(&piece, None, &calib, &model, 0.0, range);
+        let holds = |b: Bearing, column: f64| {
+            azimuth_difference(calib.azimuth(column), b.angle).abs() <= b.uncertainty
+        };
+        assert!(!holds(alone, 81.0), "{alone:?}");
+        assert!(holds(widened, 81.0) && holds(widened, 71.3), "{widened:?}");
+        assert!(widened.uncertainty < 3.0 * alone.uncertainty, "{widened:?}");
+        piece.beyond_columns = [0, 0];
+        assert_eq!(bearing_of(&piece, None, &calib, &model, 0.0, range), alone);
     }
 
     #[test]
