@@ -100,6 +100,10 @@ pub(super) fn stances(
         .collect()
 }
 
+/// Rows above and below a pixel that its stance depends on: the matching window's and the
+/// smoothing's.
+pub(super) const READ_ROWS: usize = RADIUS + 2 * SMOOTHING_PX as usize;
+
 /// Columns a neighbourhood is shifted against itself to tell whether it is textured enough
 /// for the test: past [`TOLERANCE_COLUMNS`].
 const SELF_SHIFT: isize = 2;

@@ -359,36 +359,84 @@ fn detect_in(
         })
         .collect();
     // In colour mode, how far each detected blob's rock may reach beyond what the colour test
-    // found; a piece reaches beyond its blob only on the sides where it ends the blob.
-    if let Some((own, other)) = bands
-        .as_ref()
-        .filter(|_| !luminance && !detections.is_empty())
-    {
-        let stances = ground::stances(own, other, w, top, calib, direction);
-        let raised = |c: i64, r: i64| {
-            stances[r as usize * w + c.rem_euclid(w as i64) as usize] == ground::Stance::Raised
+    // found.
+    if let Some((own, other)) = bands.as_ref().filter(|_| !luminance) {
+        let stereo = Stereo {
+            own,
+            other,
+            top,
+            direction,
+            calib,
         };
-        let mut reach = std::collections::HashMap::new();
-        for detection in &mut detections {
-            let blob = &blobs[detection.blob as usize];
-            let Some(b) = bounds(blob) else {
-                continue;
-            };
-            let [before, after] = *reach.entry(detection.blob).or_insert_with(|| {
-                let limits = (
-                    REACH_WIDTHS * (b[2] - b[0] + 1),
-                    REACH_HEIGHTS * (b[3] - b[1] + 1),
-                );
-                extent::beyond(blob, mask.as_slice(), w, rows, limits, raised)
-            });
-            detection.beyond_columns = [
-                if detection.bbox[0] == b[0] { before } else { 0 },
-                if detection.bbox[2] == b[2] { after } else { 0 },
-            ];
-        }
+        reach_beyond(&mut detections, &blobs, mask.as_slice(), w, &stereo);
     }
     detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
     detections
+}
+
+/// The ground bands of a stereo pair, for the stereo test ([`ground::stances`]).
+struct Stereo<'a> {
+    own: &'a [u16],
+    other: &'a [u16],
+    top: usize,
+    direction: isize,
+    calib: &'a Calibration,
+}
+
+/// Sets each detection's [`Detection::beyond_columns`]: the raised pixels joining its blob
+/// (`blobs`, components of the colour test's `mask`, `w` wide) beside it, on the sides where
+/// it ends the blob. The stereo test runs over the rows the searches may visit only.
+fn reach_beyond(
+    detections: &mut [Detection],
+    blobs: &[components::Component],
+    mask: &[u8],
+    w: usize,
+    stereo: &Stereo,
+) {
+    let rows = mask.len() / w;
+    let limits = |b: [u32; 4]| {
+        (
+            REACH_WIDTHS * (b[2] - b[0] + 1),
+            REACH_HEIGHTS * (b[3] - b[1] + 1),
+        )
+    };
+    let Some((first, last)) = detections
+        .iter()
+        .filter_map(|d| bounds(&blobs[d.blob as usize]))
+        .map(|b| (b[1].saturating_sub(limits(b).1) as usize, b[3] as usize + 1))
+        .reduce(|(a0, a1), (b0, b1)| (a0.min(b0), a1.max(b1)))
+    else {
+        return;
+    };
+    // The rows searched, and those the test reads around them.
+    let r0 = first.saturating_sub(ground::READ_ROWS);
+    let r1 = (last + ground::READ_ROWS + 1).min(rows);
+    let stances = ground::stances(
+        &stereo.own[r0 * w..r1 * w],
+        &stereo.other[r0 * w..r1 * w],
+        w,
+        stereo.top + r0,
+        stereo.calib,
+        stereo.direction,
+    );
+    let raised = |c: i64, r: i64| {
+        let i = (r as usize).wrapping_sub(r0).wrapping_mul(w) + c.rem_euclid(w as i64) as usize;
+        stances.get(i) == Some(&ground::Stance::Raised)
+    };
+    let mut reach = std::collections::HashMap::new();
+    for detection in detections {
+        let blob = &blobs[detection.blob as usize];
+        let Some(b) = bounds(blob) else {
+            continue;
+        };
+        let [before, after] = *reach
+            .entry(detection.blob)
+            .or_insert_with(|| extent::beyond(blob, mask, w, rows, limits(b), raised));
+        detection.beyond_columns = [
+            if detection.bbox[0] == b[0] { before } else { 0 },
+            if detection.bbox[2] == b[2] { after } else { 0 },
+        ];
+    }
 }
 
 /// Raised pixels more than this many of a blob's widths beyond it are not taken for more of
