@@ -205,11 +205,8 @@ fn unaccounted_near(
     let mut near: Vec<LandmarkId> = registrations
         .iter()
         .flat_map(|(frame, r)| {
-            let t = r.to_frame(p.point);
             frame.landmarks.iter().filter(move |(l, q)| {
-                !anchored.iter().any(|a| a.landmark == *l)
-                    && (t[0] - q.point[0]).hypot(t[1] - q.point[1])
-                        <= p.radius + q.radius + PLACEMENT_SLACK_M
+                !anchored.iter().any(|a| a.landmark == *l) && within_placement(p, *q, r)
             })
         })
         .map(|(l, _)| *l)
@@ -217,6 +214,13 @@ fn unaccounted_near(
     near.sort_unstable();
     near.dedup();
     near
+}
+
+/// Whether the station's placement `p`, moved into a frame by `registration`, lies within
+/// placement slack of the frame's landmark placed at `q`.
+fn within_placement(p: Placed, q: Placed, registration: &Registration) -> bool {
+    registration::distance(registration.to_frame(p.point), q.point)
+        <= p.radius + q.radius + PLACEMENT_SLACK_M
 }
 
 /// The frames the station registers against, with their registrations (see [`register`]).
@@ -322,11 +326,7 @@ fn placed_near(
                             return true;
                         }
                         match (placed[i], frame.landmarks.iter().find(|f| f.0 == l)) {
-                            (Some(p), Some((_, q))) => {
-                                let t = r.to_frame(p.point);
-                                (t[0] - q.point[0]).hypot(t[1] - q.point[1])
-                                    <= p.radius + q.radius + PLACEMENT_SLACK_M
-                            }
+                            (Some(p), Some((_, q))) => within_placement(p, *q, r),
                             _ => true,
                         }
                     })
@@ -543,6 +543,16 @@ mod tests {
         }
     }
 
+    /// A look unlike [`look`]'s: a rock no landmark of the gallery resembles.
+    fn other_look() -> Appearance {
+        Appearance {
+            colour: [0.2, 0.3, 0.5],
+            brightness: 3.0,
+            texture: 0.6,
+            dark_fraction: 0.5,
+        }
+    }
+
     fn at(point: [f64; 2]) -> Placed {
         Placed { point, radius: 0.3 }
     }
@@ -615,12 +625,7 @@ mod tests {
         let mut points = FIELD.to_vec();
         points.extend([[-1.0, 9.0], [-1.5, 9.0]]);
         let mut station = station(&points);
-        station.1.detections[7].appearance = Appearance {
-            colour: [0.2, 0.3, 0.5],
-            brightness: 3.0,
-            texture: 0.6,
-            dark_fraction: 0.5,
-        };
+        station.1.detections[7].appearance = other_look();
         let mut landmarks = FIELD.to_vec();
         landmarks.push([-1.25, 9.0]);
         let decisions = associate_station(&station, &[frame(&landmarks)]);
@@ -640,12 +645,7 @@ mod tests {
         points.extend([[-1.0, 9.0], [4.0, -9.0]]);
         let mut station = station(&points);
         for detection in &mut station.1.detections[6..] {
-            detection.appearance = Appearance {
-                colour: [0.2, 0.3, 0.5],
-                brightness: 3.0,
-                texture: 0.6,
-                dark_fraction: 0.5,
-            };
+            detection.appearance = other_look();
         }
         let mut landmarks = FIELD.to_vec();
         landmarks.push([-1.2, 9.0]);

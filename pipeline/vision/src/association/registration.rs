@@ -225,15 +225,13 @@ impl Registration {
             let d = (a - b).rem_euclid(std::f64::consts::TAU);
             d.min(std::f64::consts::TAU - d)
         };
-        let [cos, sin, x, y] = self.motion;
+        let motion = self.motion();
         self.pairs.retain(|&(i, l)| {
             let (Some(p), Some((_, q))) = (placed[i], frame.landmarks.iter().find(|m| m.0 == l))
             else {
                 return true;
             };
-            // The inverse motion: rotate back the landmark's offset from the shift.
-            let (dx, dy) = (q.point[0] - x, q.point[1] - y);
-            let back = direction([cos * dx + sin * dy, -sin * dx + cos * dy]);
+            let back = direction(motion.unapply(q.point));
             let own = apart(back, direction(p.point));
             elsewhere.iter().all(|&b| apart(back, b) >= own)
         });
@@ -241,13 +239,16 @@ impl Registration {
 
     /// Where the current station's point `p` lies in the frame's coordinates.
     pub fn to_frame(&self, p: [f64; 2]) -> [f64; 2] {
+        self.motion().apply(p)
+    }
+
+    fn motion(&self) -> Motion {
         let [cos, sin, x, y] = self.motion;
         Motion {
             cos,
             sin,
             shift: [x, y],
         }
-        .apply(p)
     }
 }
 
@@ -320,6 +321,16 @@ impl Motion {
         [
             self.cos * p[0] - self.sin * p[1] + self.shift[0],
             self.sin * p[0] + self.cos * p[1] + self.shift[1],
+        ]
+    }
+
+    /// The inverse of [`Motion::apply`]: the point `q` of the frame in the station's
+    /// coordinates (the offset from the shift rotated back).
+    fn unapply(&self, q: [f64; 2]) -> [f64; 2] {
+        let (dx, dy) = (q[0] - self.shift[0], q[1] - self.shift[1]);
+        [
+            self.cos * dx + self.sin * dy,
+            -self.sin * dx + self.cos * dy,
         ]
     }
 }
