@@ -420,8 +420,9 @@ fn reach_beyond(
         stereo.direction,
     );
     let raised = |c: i64, r: i64| {
-        let i = (r as usize).wrapping_sub(r0).wrapping_mul(w) + c.rem_euclid(w as i64) as usize;
-        stances.get(i) == Some(&ground::Stance::Raised)
+        let row = usize::try_from(r).ok().and_then(|r| r.checked_sub(r0));
+        row.and_then(|row| stances.get(row * w + c.rem_euclid(w as i64) as usize))
+            == Some(&ground::Stance::Raised)
     };
     let mut reach = std::collections::HashMap::new();
     for detection in detections {
