@@ -322,6 +322,76 @@ fn fatal_input_errors_exit_2_and_write_nothing() {
     );
 }
 
+/// Another dataset's truth is refused with exit 2, by `run --truth` before any work and by
+/// `eval`, which leaves the run's eval.json as it was. The datasets share their file names and
+/// image size (every synthetic set does): only the images' fingerprints tell them apart.
+#[test]
+fn another_datasets_truth_is_refused_and_nothing_is_overwritten() {
+    let dataset = demo_copy("other-truth", 3);
+    // The same names and size, other images: stations 0 and 1 swapped.
+    let (a, b) = (
+        dataset.as_ref().join("station_000_left.png"),
+        dataset.as_ref().join("station_001_left.png"),
+    );
+    let (bytes_a, bytes_b) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    std::fs::write(&a, &bytes_b).unwrap();
+    std::fs::write(&b, &bytes_a).unwrap();
+    let truth = Path::new(DEMO).join("truth.json");
+    let out = scratch("other-truth-run");
+    let o = pipeline(&[
+        "run",
+        "--images",
+        arg(dataset.as_ref()),
+        "--out",
+        arg(out.as_ref()),
+        "--truth",
+        arg(&truth),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("station_000_left.png is not the image the truth file describes")
+            && stderr(&o).contains("nothing was written"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(std::fs::read_dir(&out).unwrap().next().is_none());
+
+    // Scored against its own truth (the demo's, of the unswapped images), then against the
+    // demo's for the swapped ones: refused, and the first scoring stays.
+    let good = demo_copy("own-truth", 3);
+    let run = scratch("own-truth-run");
+    let o = pipeline(&[
+        "run",
+        "--images",
+        arg(good.as_ref()),
+        "--out",
+        arg(run.as_ref()),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let scored = std::fs::read(run.as_ref().join("eval.json")).unwrap();
+    let mut foreign: serde_json::Value = json(&good.as_ref().join("truth.json"));
+    foreign["images"][0]["digest"] = serde_json::Value::from("crc32:00000000");
+    let foreign_path = good.as_ref().join("foreign-truth.json");
+    std::fs::write(&foreign_path, foreign.to_string()).unwrap();
+    let o = pipeline(&[
+        "eval",
+        "--run",
+        arg(run.as_ref()),
+        "--truth",
+        arg(&foreign_path),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("does not fit the run") && stderr(&o).contains("crc32:00000000"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read(run.as_ref().join("eval.json")).unwrap(),
+        scored
+    );
+}
+
 #[test]
 fn a_bad_image_is_skipped_with_a_warning() {
     let dir = demo_copy("bad-images", 5);

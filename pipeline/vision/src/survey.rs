@@ -171,6 +171,16 @@ fn into_rgb(image: image::DynamicImage) -> RgbImage {
     }
 }
 
+/// A fingerprint of a file's bytes (`crc32:` and eight hex digits): `truth.json` records one
+/// per image and `stations.json` one per file read, so that scoring refuses a truth file
+/// written for other images, even ones of the same names and size.
+pub fn digest(path: &Path) -> std::io::Result<String> {
+    Ok(format!(
+        "crc32:{:08x}",
+        crc32fast::hash(&std::fs::read(path)?)
+    ))
+}
+
 /// Reads one panorama as 8-bit RGB and checks its size against the calibration's.
 pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageError> {
     let reader = image::ImageReader::open(path)

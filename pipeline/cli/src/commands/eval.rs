@@ -2,7 +2,7 @@
 //! (docs/RUN.md): eval.json and a printed report.
 
 use super::output::write_atomic;
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
@@ -11,6 +11,7 @@ use qrm_synth::evaluation::{self, Detectable, Evaluation, RunFiles};
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::DetectorSettings;
 use qrm_vision::run::{LandmarkRecord, StationRecord};
+use qrm_vision::survey::{self, Survey};
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -51,6 +52,21 @@ fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
 /// work, so that a bad one fails with nothing written.
 pub fn read_truth(path: &Path) -> Result<Truth> {
     read(path)
+}
+
+/// Whether `truth` describes every image of `survey`, file by file (names and fingerprints:
+/// `evaluation::describes`), checked before a run does any work.
+pub fn check_survey(truth: &Truth, survey: &Survey) -> Result<()> {
+    for station in &survey.stations {
+        for path in std::iter::once(&station.primary).chain(&station.right) {
+            let file = path.strip_prefix(&survey.directory).unwrap_or(path);
+            let digest =
+                survey::digest(path).with_context(|| format!("cannot read {}", path.display()))?;
+            evaluation::describes(truth, &file.display().to_string(), Some(&digest))
+                .map_err(|problem| anyhow!("{problem}"))?;
+        }
+    }
+    Ok(())
 }
 
 /// Scores the run in `run_dir` against `truth_path`, writing `eval.json` into `out`.

@@ -155,7 +155,9 @@ pub fn run(args: RunArgs) -> Result<()> {
     let survey = Survey::open(&args.images)?;
     let calib = load_calibration(&args)?;
     if let Some(truth) = args.truth.as_deref().filter(|_| !args.no_eval) {
-        super::eval::read_truth(truth).context("--truth; nothing was written")?;
+        let contents = super::eval::read_truth(truth).context("--truth; nothing was written")?;
+        super::eval::check_survey(&contents, &survey)
+            .with_context(|| format!("--truth {}; nothing was written", truth.display()))?;
     }
     for path in &survey.unpaired {
         eprintln!(

@@ -74,6 +74,7 @@ fn station(index: usize) -> StationRecord {
             format!("station_{index:03}_left.png"),
             format!("station_{index:03}_right.png"),
         ],
+        digests: Vec::new(),
         channels: Channels::Colour,
         detections,
         order: vec![(0, 1), (0, 2)],

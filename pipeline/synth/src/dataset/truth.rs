@@ -95,6 +95,10 @@ pub struct ImageTruth {
     pub eye: String,
     /// Rocks with at least one visible pixel.
     pub rocks: Vec<VisibleRock>,
+    /// Fingerprint of the image file as written (`qrm_vision::survey::digest`); absent in
+    /// truth files written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub digest: Option<String>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

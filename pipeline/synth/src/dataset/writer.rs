@@ -23,6 +23,11 @@ pub enum DatasetError {
         path: PathBuf,
         source: image::ImageError,
     },
+    #[error("cannot read back {path} for its fingerprint: {source}")]
+    ReadBack {
+        path: PathBuf,
+        source: std::io::Error,
+    },
 }
 
 /// What to render.
@@ -82,12 +87,20 @@ pub fn write_dataset(
                     } else {
                         format!("{}.{extension}", names[i])
                     };
-                    write_image(&dir.join(&file), &recorded, request.encoding)?;
+                    let path = dir.join(&file);
+                    write_image(&path, &recorded, request.encoding)?;
+                    let digest = qrm_vision::survey::digest(&path).map_err(|source| {
+                        DatasetError::ReadBack {
+                            path: path.clone(),
+                            source,
+                        }
+                    })?;
                     Ok(ImageTruth {
                         file,
                         station: i,
                         eye: label.to_string(),
                         rocks: visible_rocks(&world, calib, pose, eye, &image),
+                        digest: Some(digest),
                     })
                 })
                 .collect::<Result<Vec<_>, DatasetError>>();

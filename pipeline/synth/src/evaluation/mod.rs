@@ -166,6 +166,11 @@ pub fn check_files(
         }
     }
     for record in records {
+        for (k, file) in record.files.iter().enumerate() {
+            let digest = record.digests.get(k).map(String::as_str);
+            describes(truth, file, digest)
+                .map_err(|problem| format!("station {}: {problem}", record.station))?;
+        }
         let n = record.detections.len();
         if let Some(&(i, j)) = record.order.iter().find(|&&(i, j)| i >= n || j >= n) {
             return Err(format!(
@@ -189,6 +194,23 @@ pub fn check_files(
         }
     }
     Ok(())
+}
+
+/// Whether `truth` describes the image `file` (relative to the image directory) with
+/// fingerprint `digest` (`qrm_vision::survey::digest`; empty or `None` when unknown): it must
+/// list the file, and when both fingerprints are known they must agree. Synthetic datasets
+/// share their file names, and many their image size, so names alone would let another
+/// dataset's truth score a run as if it were this one's (at precision 0, exit 0).
+pub fn describes(truth: &Truth, file: &str, digest: Option<&str>) -> Result<(), String> {
+    let Some(image) = truth.images.iter().find(|i| i.file == file) else {
+        return Err(format!("the truth file does not describe {file}"));
+    };
+    match (image.digest.as_deref(), digest.filter(|d| !d.is_empty())) {
+        (Some(theirs), Some(ours)) if theirs != ours => Err(format!(
+            "{file} is not the image the truth file describes (fingerprint {ours}, the truth's {theirs})"
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Everything `score_run` needs, read by the caller.

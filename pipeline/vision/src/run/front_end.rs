@@ -6,7 +6,7 @@ use crate::calib::Calibration;
 use crate::detection::{detect, detect_right, Channels, DetectorSettings};
 use crate::ranging::PrimaryEye;
 use crate::run::StationDetections;
-use crate::survey::{is_jpeg, read_image, Station};
+use crate::survey::{digest, is_jpeg, read_image, Station};
 use std::path::Path;
 use std::time::Instant;
 
@@ -82,10 +82,14 @@ pub fn detect_station(
         .as_ref()
         .map(|r| detect_right(r, Some(&primary), calib, settings));
     detect_seconds += start.elapsed().as_secs_f64();
-    let mut files = vec![name(&station.primary)];
-    if let Some(path) = station.right.as_ref().filter(|_| right.is_some()) {
-        files.push(name(path));
-    }
+    let mut paths = vec![station.primary.as_path()];
+    paths.extend(station.right.as_deref().filter(|_| right.is_some()));
+    let files = paths.iter().map(|p| name(p)).collect();
+    // A file that decoded a moment ago and cannot be read again has no fingerprint (empty).
+    let digests = paths
+        .iter()
+        .map(|p| digest(p).unwrap_or_default())
+        .collect();
     let eye = if station.right.is_some() || is_left_image(&station.primary) {
         PrimaryEye::Left
     } else {
@@ -95,6 +99,7 @@ pub fn detect_station(
         station: Ok(StationDetections {
             name: station.name.clone(),
             files,
+            digests,
             eye,
             channels,
             primary: primary_detections,

@@ -21,6 +21,8 @@ use std::time::Instant;
 pub struct StationDetections {
     pub name: String,
     pub files: Vec<String>,
+    /// Fingerprints of `files` ([`crate::survey::digest`]).
+    pub digests: Vec<String>,
     pub eye: PrimaryEye,
     /// The detector's mode for the primary panorama (`Channels::resolve`).
     pub channels: crate::detection::Channels,
@@ -119,6 +121,7 @@ impl<C: Calculus> Mapper<C> {
             index,
             station: station.name.clone(),
             files: station.files.clone(),
+            digests: station.digests.clone(),
             channels: station.channels,
             warnings: station.warnings.clone(),
             ..StationRecord::default()

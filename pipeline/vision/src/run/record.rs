@@ -13,6 +13,10 @@ pub struct StationRecord {
     pub station: String,
     /// Image files read for this station (left first), relative to the image directory.
     pub files: Vec<String>,
+    /// Fingerprints of `files`, in order (`survey::digest`; empty when unknown): scoring
+    /// checks them against `truth.json`'s.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub digests: Vec<String>,
     /// What told rocks from the ground in its panorama: `colour`, or `luminance` (and stereo
     /// height) for grayscale or JPEG panoramas.
     #[serde(default)]
