@@ -310,6 +310,23 @@ fn fatal_input_errors_exit_2_and_write_nothing() {
         let written: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
         assert!(written.is_empty(), "{}: wrote {written:?}", truth.display());
     }
+    // The image directory as the output directory: the next run would read rng.png.
+    let same = demo_copy("same-out", 2);
+    let o = pipeline(&[
+        "run",
+        "--images",
+        arg(same.as_ref()),
+        "--out",
+        arg(same.as_ref()),
+        "--no-eval",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is the image directory"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!same.as_ref().join("map.json").exists());
     // An output path that is a file.
     let file = empty.join("a-file");
     std::fs::write(&file, b"x").unwrap();

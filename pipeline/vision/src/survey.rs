@@ -27,6 +27,11 @@ pub struct Survey {
     pub stations: Vec<Station>,
     /// `NAME_right` files without a `NAME_left` partner: reported, not used.
     pub unpaired: Vec<PathBuf>,
+    /// `NAME_left` files without a `NAME_right` partner: reported, mapped without stereo.
+    pub without_right: Vec<PathBuf>,
+    /// Images whose name leaves no station name (`_left.png`, `_right.png`): reported, not
+    /// used. Hidden files (`.NAME`) are not panoramas and are passed over silently.
+    pub unnamed: Vec<PathBuf>,
 }
 
 #[derive(Debug, Error)]
@@ -94,11 +99,18 @@ impl Survey {
 
     /// Groups image paths into stations (pure: no file system access).
     pub fn from_files(directory: &Path, mut images: Vec<PathBuf>) -> Survey {
+        images.retain(|p| !stem(p).starts_with('.'));
         images.sort_by(|a, b| natural_order(&stem(a), &stem(b)));
         let mut stations = Vec::new();
         let mut unpaired = Vec::new();
+        let mut without_right = Vec::new();
+        let mut unnamed = Vec::new();
         for path in &images {
             let name = stem(path);
+            if name.is_empty() || name == "_left" || name == "_right" {
+                unnamed.push(path.clone());
+                continue;
+            }
             if let Some(base) = name.strip_suffix("_right") {
                 let has_left = images.iter().any(|p| stem(p) == format!("{base}_left"));
                 if !has_left {
@@ -112,6 +124,9 @@ impl Survey {
                         .iter()
                         .find(|p| stem(p) == format!("{base}_right"))
                         .cloned();
+                    if right.is_none() {
+                        without_right.push(path.clone());
+                    }
                     (base.to_string(), right)
                 }
                 None => (name.clone(), None),
@@ -126,6 +141,8 @@ impl Survey {
             directory: directory.to_path_buf(),
             stations,
             unpaired,
+            without_right,
+            unnamed,
         }
     }
 }
@@ -284,6 +301,30 @@ mod tests {
         );
         assert_eq!(survey.stations[0].right, None);
         assert_eq!(survey.unpaired, vec![PathBuf::from("d/lonely_right.png")]);
+        assert!(survey.without_right.is_empty() && survey.unnamed.is_empty());
+    }
+
+    /// Hidden files are not panoramas; names that leave no station name, and left panoramas
+    /// without their right partner, are reported.
+    #[test]
+    fn hidden_unnamed_and_unpartnered_files_are_set_apart() {
+        let survey = Survey::from_files(
+            Path::new("d"),
+            paths(&[
+                ".hidden.png",
+                "._s_1_left.png",
+                "_left.png",
+                "_right.png",
+                "s_1_left.png",
+                "s_1_right.png",
+                "s_2_left.png",
+            ]),
+        );
+        let names: Vec<_> = survey.stations.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["s_1", "s_2"]);
+        assert_eq!(survey.unnamed, paths(&["_left.png", "_right.png"]));
+        assert_eq!(survey.without_right, paths(&["s_2_left.png"]));
+        assert!(survey.unpaired.is_empty());
     }
 
     #[test]

@@ -153,6 +153,13 @@ impl Progress for Bars {
 pub fn run(args: RunArgs) -> Result<()> {
     let started = Instant::now();
     let survey = Survey::open(&args.images)?;
+    // The run's pictures (rng.png) would be read as panoramas by the next run.
+    if same_directory(&args.out, &args.images) {
+        bail!(
+            "--out {} is the image directory: the next run would read the outputs (rng.png) as panoramas; nothing was written",
+            args.out.display()
+        );
+    }
     let calib = load_calibration(&args)?;
     if let Some(truth) = args.truth.as_deref().filter(|_| !args.no_eval) {
         let contents = super::eval::read_truth(truth).context("--truth; nothing was written")?;
@@ -162,6 +169,18 @@ pub fn run(args: RunArgs) -> Result<()> {
     for path in &survey.unpaired {
         eprintln!(
             "warning: {} has no _left partner and is not used",
+            path.display()
+        );
+    }
+    for path in &survey.unnamed {
+        eprintln!(
+            "warning: {} leaves no station name (NAME_left, NAME_right or NAME) and is not used",
+            path.display()
+        );
+    }
+    for path in &survey.without_right {
+        eprintln!(
+            "warning: {} has no _right partner: its station is mapped without stereo",
             path.display()
         );
     }
@@ -214,6 +233,14 @@ pub fn run(args: RunArgs) -> Result<()> {
         super::eval::print_report(evaluation);
     }
     Ok(())
+}
+
+/// Whether `a` and `b` name the same existing directory.
+fn same_directory(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
 }
 
 /// `--calib`, or calib.toml in the image directory.
