@@ -92,6 +92,14 @@ pub enum CalibrationError {
     },
 }
 
+/// Largest ratio of a pixel's height to its width (or width to height) a calibration may
+/// describe: `focal_px` (rows per unit of tan(elevation)) within this factor of the columns per
+/// radian. The synthetic camera's pixels are square (ratio 1).
+const MAX_PIXEL_ASPECT: f64 = 4.0;
+
+/// Highest mast a calibration may describe, metres (rover masts are 1–2 m).
+const MAX_MAST_M: f64 = 20.0;
+
 impl Calibration {
     /// Reads and checks a calibration file.
     pub fn load(path: &Path) -> Result<Calibration, CalibrationError> {
@@ -180,6 +188,38 @@ impl Calibration {
         }
         if self.stereo.baseline_m < 0.0 {
             return bad("stereo.baseline_m", "must not be negative".to_string());
+        }
+        // Plausibility from the camera's geometry: values that parse but describe no rover
+        // camera (focal_px 1e300 or baseline_m 1e30 ran to an empty map, exit 0).
+        let per_radian = f64::from(self.image.width) / std::f64::consts::TAU;
+        let (low, high) = (per_radian / MAX_PIXEL_ASPECT, per_radian * MAX_PIXEL_ASPECT);
+        if !(low..=high).contains(&self.elevation.focal_px) {
+            return bad(
+                "elevation.focal_px",
+                format!(
+                    "is {:?}, but {} columns over the full turn make {per_radian:.1} columns per \
+                     radian, and a panorama's pixels are near square: use {low:.1}..={high:.1}",
+                    self.elevation.focal_px, self.image.width
+                ),
+            );
+        }
+        if self.mast.height_m > MAX_MAST_M {
+            return bad(
+                "mast.height_m",
+                format!(
+                    "is {:?} m; a rover's mast is at most {MAX_MAST_M} m",
+                    self.mast.height_m
+                ),
+            );
+        }
+        if self.stereo.baseline_m > 2.0 * self.mast.height_m {
+            return bad(
+                "stereo.baseline_m",
+                format!(
+                    "is {:?} m, more than twice the mast's height ({} m): the stereo head sits on the mast",
+                    self.stereo.baseline_m, self.mast.height_m
+                ),
+            );
         }
         Ok(())
     }
@@ -318,6 +358,22 @@ mod tests {
         let bad = EXAMPLE.replace("focal_px = 652.0", "focal_px = -1.0");
         let e = Calibration::parse(&bad, "x.toml").unwrap_err().to_string();
         assert!(e.contains("elevation.focal_px"), "{e}");
+        for (from, to, field) in [
+            ("focal_px = 652.0", "focal_px = 1e300", "elevation.focal_px"),
+            (
+                "focal_px = 652.0",
+                "focal_px = 1e-300",
+                "elevation.focal_px",
+            ),
+            ("baseline_m = 0.3", "baseline_m = 1e30", "stereo.baseline_m"),
+            ("height_m = 1.5", "height_m = 1e30", "mast.height_m"),
+        ] {
+            let implausible = EXAMPLE.replace(from, to);
+            let e = Calibration::parse(&implausible, "x.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(field), "{to}: {e}");
+        }
         let unknown = format!("{EXAMPLE}\n[extra]\nfoo = 1\n");
         let e = Calibration::parse(&unknown, "x.toml")
             .unwrap_err()
