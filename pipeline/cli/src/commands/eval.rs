@@ -141,11 +141,11 @@ pub fn print_report(e: &Evaluation) {
         );
     }
     println!(
-        "  range order: {} of {} pairs asserted, {} wrong; {} cue conflicts",
+        "  range order: {} of the {} pairs of detections matched to rocks asserted, {} wrong; {} cue conflicts",
         r.asserted_pairs, r.pairs, r.wrong_pairs, r.conflicts
     );
     println!(
-        "  of all {} asserted pairs, separated by ground alone {}, stereo alone {}, size alone {}, only by the fusion {}",
+        "  of all {} asserted pairs (matched to rocks or not), separated by ground alone {}, stereo alone {}, size alone {}, only by the fusion {}",
         r.asserted_all,
         r.separated_by_ground, r.separated_by_stereo, r.separated_by_size, r.separated_only_fused
     );
