@@ -409,6 +409,41 @@ fn another_datasets_truth_is_refused_and_nothing_is_overwritten() {
     );
 }
 
+/// `--quiet`: no progress and no warning lines while running; the warnings are tallied by kind
+/// after the summary, as they are (after the lines) without it.
+#[test]
+fn quiet_runs_tally_warnings_without_printing_them() {
+    let dir = demo_copy("quiet", 3);
+    std::fs::remove_file(dir.as_ref().join("station_001_right.png")).unwrap();
+    std::fs::copy(
+        dir.as_ref().join("station_000_left.png"),
+        dir.as_ref().join("_left.png"),
+    )
+    .unwrap();
+    for quiet in [true, false] {
+        let out = scratch("quiet-out");
+        let mut args = vec![
+            "run",
+            "--images",
+            arg(dir.as_ref()),
+            "--out",
+            arg(out.as_ref()),
+        ];
+        if quiet {
+            args.push("--quiet");
+        }
+        let o = pipeline(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let stdout = String::from_utf8_lossy(&o.stdout).to_string();
+        assert_eq!(stderr(&o).contains("warning:"), !quiet, "{}", stderr(&o));
+        assert!(stdout.contains("warnings: 2,"), "{stdout}");
+        assert!(
+            stdout.contains("1 × ") && stdout.contains("has no _right partner"),
+            "{stdout}"
+        );
+    }
+}
+
 #[test]
 fn a_bad_image_is_skipped_with_a_warning() {
     let dir = demo_copy("bad-images", 5);

@@ -47,6 +47,10 @@ pub struct RunArgs {
     /// `auto` picks it for grayscale panoramas and JPEG stereo pairs, colour otherwise.
     #[arg(long, value_enum, default_value_t = ChannelsArg::Auto)]
     pub channels: ChannelsArg,
+    /// No progress bars and no warning lines while running: the warnings are counted by kind
+    /// at the end (each station's are in stations.json).
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// `--channels` (`qrm_vision::detection::Channels`).
@@ -100,13 +104,45 @@ fn rng_drawing(map: &Hypergraph<Edc>) -> RngDrawing {
     }
 }
 
-/// Progress bars on the terminal, one per stage; warnings printed above them.
+/// Progress bars on the terminal, one per stage; warnings printed above them and kept for
+/// the tally at the end. Quiet: neither bars nor warning lines.
 #[derive(Default)]
 struct Bars {
     current: Mutex<Option<ProgressBar>>,
+    warnings: Mutex<Vec<String>>,
+    quiet: bool,
 }
 
 impl Bars {
+    fn quiet() -> Bars {
+        Bars {
+            quiet: true,
+            ..Bars::default()
+        }
+    }
+
+    /// The warnings by kind (digits masked: one kind for every station and count), most
+    /// frequent first, each with its first message.
+    fn tally(&self) -> Vec<(usize, String)> {
+        let warnings = self.warnings.lock().expect("no panics hold it");
+        let mut kinds: Vec<(String, usize, String)> = Vec::new();
+        for message in warnings.iter() {
+            let kind: String = message
+                .chars()
+                .map(|c| if c.is_ascii_digit() { '#' } else { c })
+                .collect();
+            match kinds.iter_mut().find(|(k, _, _)| *k == kind) {
+                Some((_, count, _)) => *count += 1,
+                None => kinds.push((kind, 1, message.clone())),
+            }
+        }
+        kinds.sort_by(|a, b| b.1.cmp(&a.1));
+        kinds
+            .into_iter()
+            .map(|(_, n, example)| (n, example))
+            .collect()
+    }
+
     fn with_bar(&self, f: impl FnOnce(&ProgressBar)) {
         if let Some(bar) = self.current.lock().expect("no panics hold it").as_ref() {
             f(bar);
@@ -116,6 +152,9 @@ impl Bars {
 
 impl Progress for Bars {
     fn begin(&self, stage: Stage, stations: usize) {
+        if self.quiet {
+            return;
+        }
         let what = match stage {
             Stage::Detect => "detect",
             Stage::Map => "map",
@@ -142,6 +181,13 @@ impl Progress for Bars {
     }
 
     fn warn(&self, message: &str) {
+        self.warnings
+            .lock()
+            .expect("no panics hold it")
+            .push(message.to_string());
+        if self.quiet {
+            return;
+        }
         let print = || eprintln!("warning: {message}");
         match self.current.lock().expect("no panics hold it").as_ref() {
             Some(bar) => bar.suspend(print),
@@ -166,23 +212,28 @@ pub fn run(args: RunArgs) -> Result<()> {
         super::eval::check_survey(&contents, &survey)
             .with_context(|| format!("--truth {}; nothing was written", truth.display()))?;
     }
+    let bars = if args.quiet {
+        Bars::quiet()
+    } else {
+        Bars::default()
+    };
     for path in &survey.unpaired {
-        eprintln!(
-            "warning: {} has no _left partner and is not used",
+        bars.warn(&format!(
+            "{} has no _left partner and is not used",
             path.display()
-        );
+        ));
     }
     for path in &survey.unnamed {
-        eprintln!(
-            "warning: {} leaves no station name (NAME_left, NAME_right or NAME) and is not used",
+        bars.warn(&format!(
+            "{} leaves no station name (NAME_left, NAME_right or NAME) and is not used",
             path.display()
-        );
+        ));
     }
     for path in &survey.without_right {
-        eprintln!(
-            "warning: {} has no _right partner: its station is mapped without stereo",
+        bars.warn(&format!(
+            "{} has no _right partner: its station is mapped without stereo",
             path.display()
-        );
+        ));
     }
     #[cfg(not(feature = "rerun"))]
     if args.rrd {
@@ -191,7 +242,6 @@ pub fn run(args: RunArgs) -> Result<()> {
 
     let mut settings = RunSettings::default();
     settings.detector.channels = args.channels.into();
-    let bars = Bars::default();
     let detected = match detect_survey(&survey, &calib, &settings.detector, &bars) {
         Ok(detected) => detected,
         Err(e) => bail!("{e}; nothing was written"),
@@ -229,6 +279,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     };
     // Printed once every file is written: a reader that stops early ends the process.
     print_summary(&summary, &args.out, started);
+    print_warnings(&bars.tally(), args.quiet);
     if let Some(evaluation) = &evaluation {
         super::eval::print_report(evaluation);
     }
@@ -301,6 +352,29 @@ fn print_summary(summary: &RunSummary, out: &Path, started: Instant) {
         out.join("map.json").display(),
         out.join("run.mcap").display()
     );
+}
+
+/// The warnings by kind, after the summary: a long survey prints hundreds of lines above it.
+fn print_warnings(tally: &[(usize, String)], quiet: bool) {
+    let total: usize = tally.iter().map(|(n, _)| n).sum();
+    if total == 0 {
+        return;
+    }
+    let shown = if quiet {
+        "not printed (--quiet)"
+    } else {
+        "printed above"
+    };
+    println!(
+        "warnings: {total}, {shown}; a station's are also in its stations.json record. By kind:"
+    );
+    const KINDS: usize = 8;
+    for (count, example) in tally.iter().take(KINDS) {
+        println!("  {count} × {example}");
+    }
+    if tally.len() > KINDS {
+        println!("  … and {} more kinds", tally.len() - KINDS);
+    }
 }
 
 /// Removes an output of an earlier run into the same directory that this run does not write.
