@@ -136,7 +136,7 @@ impl Bars {
                 None => kinds.push((kind, 1, message.clone())),
             }
         }
-        kinds.sort_by(|a, b| b.1.cmp(&a.1));
+        kinds.sort_by_key(|k| std::cmp::Reverse(k.1));
         kinds
             .into_iter()
             .map(|(_, n, example)| (n, example))
