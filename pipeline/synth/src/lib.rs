@@ -27,7 +27,7 @@ mod world;
 
 pub use capture::Capture;
 pub use image_file::Encoding;
-pub use render::{optical_centre, render, Eye, Pose, Render};
+pub use render::{optical_centre, render, viewing_azimuth, Eye, Pose, Render};
 pub use scenery::Scenery;
 pub use world::{Lump, Rock, World};
 

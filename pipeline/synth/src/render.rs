@@ -58,15 +58,36 @@ struct Candidate {
 /// azimuth `azimuth`: the rotating stereo head puts the left camera baseline/2 to the left of
 /// the viewing direction and the right camera baseline/2 to its right.
 pub fn optical_centre(calib: &Calibration, pose: Pose, eye: Eye, azimuth: f64) -> Point {
-    let offset = match eye {
-        Eye::Mono => 0.0,
-        Eye::Left => 0.5 * calib.stereo.baseline_m,
-        Eye::Right => -0.5 * calib.stereo.baseline_m,
-    };
+    let offset = eye_offset(calib, eye);
     Point::new(
         pose.position.x - offset * azimuth.sin(),
         pose.position.y + offset * azimuth.cos(),
     )
+}
+
+/// How far `eye` sits to the left of the viewing direction, metres.
+fn eye_offset(calib: &Calibration, eye: Eye) -> f64 {
+    match eye {
+        Eye::Mono => 0.0,
+        Eye::Left => 0.5 * calib.stereo.baseline_m,
+        Eye::Right => -0.5 * calib.stereo.baseline_m,
+    }
+}
+
+/// The world azimuth of the column of `eye` whose ray, from that column's optical centre
+/// ([`optical_centre`]), passes through `point`. With the eye `s` to the left of the viewing
+/// direction φ, the ray meets `point` when `d · sin(θ − φ) = s`, `θ` and `d` being the azimuth
+/// and distance of `point` from the station centre: `φ = θ − asin(s / d)` (calib/README.md). A
+/// point within half a baseline of the centre, which no column sees, gets `θ`.
+pub fn viewing_azimuth(calib: &Calibration, pose: Pose, eye: Eye, point: Point) -> f64 {
+    let (dx, dy) = (point.x - pose.position.x, point.y - pose.position.y);
+    let (theta, d) = (dy.atan2(dx), dx.hypot(dy));
+    let s = eye_offset(calib, eye);
+    if d > s.abs() {
+        theta - (s / d).asin()
+    } else {
+        theta
+    }
 }
 
 /// Renders one panorama: each column is a ray fan at that column's azimuth; for Left/Right the

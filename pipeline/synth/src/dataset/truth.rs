@@ -1,7 +1,7 @@
 //! `truth.json`: the ground truth of a synthetic dataset (format in `datasets/README.md`). Only
 //! evaluation reads it; the pipeline proper never does.
 
-use crate::{optical_centre, Eye, Pose, Render, World};
+use crate::{optical_centre, viewing_azimuth, Eye, Pose, Render, World};
 use qrm_vision::calib::{Calibration, ColumnDirection};
 use serde::{Deserialize, Serialize};
 
@@ -204,7 +204,7 @@ pub fn visible_rocks(
             })
             .sum();
         let rock = &world.rocks[index];
-        let azimuth = (rock.position.y - pose.position.y).atan2(rock.position.x - pose.position.x);
+        let azimuth = viewing_azimuth(calib, pose, eye, rock.position);
         let centre = optical_centre(calib, pose, eye, azimuth);
         let (dx, dy) = (rock.position.x - centre.x, rock.position.y - centre.y);
         let range = dx.hypot(dy);
