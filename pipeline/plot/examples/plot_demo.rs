@@ -121,11 +121,14 @@ fn main() -> anyhow::Result<()> {
             )
         })
         .collect();
+    let labels: Vec<String> = (0..landmarks.len()).map(|i| i.to_string()).collect();
     write_rng(
         &rng_path,
         &RngPicture {
             title: "RNG estimate after image 15".into(),
             landmarks: &landmarks,
+            labels: &labels,
+            metric: true,
             edges: &edges,
             true_edges: &true_edges,
             stations: &stations,

@@ -119,6 +119,8 @@ mod tests {
         let picture = RngPicture {
             title: "t".into(),
             landmarks: &[(0.0, 0.0), (1.0, 1.0)],
+            labels: &[],
+            metric: true,
             edges: &[(0, 1, 0.5)],
             true_edges: &[],
             stations: &[],
@@ -143,6 +145,8 @@ mod tests {
         let picture = RngPicture {
             title: "new".into(),
             landmarks: &[(0.0, 0.0)],
+            labels: &[],
+            metric: false,
             edges: &[],
             true_edges: &[],
             stations: &[],

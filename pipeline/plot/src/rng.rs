@@ -13,8 +13,8 @@ use super::ticks::tick_formatter;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::{
-    ChartBuilder, Circle, DrawingArea, DrawingAreaErrorKind, DrawingBackend, PathElement,
-    TriangleMarker,
+    ChartBuilder, Circle, DrawingArea, DrawingAreaErrorKind, DrawingBackend, EmptyElement,
+    PathElement, Text, TriangleMarker,
 };
 use plotters::style::{Color, IntoFont, RGBColor, WHITE};
 use std::ops::Range;
@@ -27,6 +27,11 @@ pub struct RngPicture<'a> {
     pub title: String,
     /// Ground-truth landmark positions; only used for drawing.
     pub landmarks: &'a [(f64, f64)],
+    /// Each landmark's name (its map id), drawn beside it; empty: none drawn.
+    pub labels: &'a [String],
+    /// Whether the positions are metric (ground truth): otherwise (a graph layout) the axes
+    /// carry no numbers, which would mean nothing.
+    pub metric: bool,
     /// Estimated edges `(i, j, w)` between landmark indices with cost `w ∈ [0, 1]`: black for
     /// `w = 0`, then dark blue → red as `w → 1`.
     pub edges: &'a [(usize, usize, f64)],
@@ -69,6 +74,9 @@ fn validate(picture: &RngPicture) -> Result<(), String> {
             "landmark {i} is at {:?}, not a finite position",
             picture.landmarks[i]
         ));
+    }
+    if !picture.labels.is_empty() && picture.labels.len() != n {
+        return Err(format!("{} labels for {n} landmarks", picture.labels.len()));
     }
     if let Some(i) = picture.stations.iter().position(|p| !finite(p)) {
         return Err(format!(
@@ -141,20 +149,22 @@ impl Figure for RngPicture<'_> {
         } else {
             root.titled(&self.title, (FAMILY, 26))?
         };
-        let mut entries = vec![
-            Entry {
-                key: Key::Circle(LANDMARK),
-                label: "landmark".into(),
-            },
-            Entry {
+        let mut entries = vec![Entry {
+            key: Key::Circle(LANDMARK),
+            label: "landmark".into(),
+        }];
+        if self.edges.iter().any(|e| e.2 == 0.0) {
+            entries.push(Entry {
                 key: Key::Line(RGBColor(0, 0, 0)),
-                label: "RNG edge, w = 0".into(),
-            },
-            Entry {
+                label: "certain RNG edge (w = 0)".into(),
+            });
+        }
+        if self.edges.iter().any(|e| e.2 > 0.0) {
+            entries.push(Entry {
                 key: Key::CostScale,
-                label: "0 < w ≤ 1".into(),
-            },
-        ];
+                label: "uncertain edge, cost w from 0 (blue) to 1 (red)".into(),
+            });
+        }
         if !self.true_edges.is_empty() {
             entries.push(Entry {
                 key: Key::Dashed(TRUE_EDGE),
@@ -188,12 +198,20 @@ impl Figure for RngPicture<'_> {
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(x_range, y_range)?;
-        chart
-            .configure_mesh()
-            .x_desc("x")
-            .y_desc("y")
-            .x_label_formatter(&x_ticks)
-            .y_label_formatter(&y_ticks)
+        let blank = |_: &f64| String::new();
+        let (x_desc, y_desc) = if self.metric {
+            ("x (m)", "y (m)")
+        } else {
+            ("graph layout: positions carry no distances", "")
+        };
+        let mut mesh = chart.configure_mesh();
+        if !self.metric {
+            mesh.disable_mesh();
+        }
+        mesh.x_desc(x_desc)
+            .y_desc(y_desc)
+            .x_label_formatter(if self.metric { &x_ticks } else { &blank })
+            .y_label_formatter(if self.metric { &y_ticks } else { &blank })
             .label_style((FAMILY, 17).into_font())
             .axis_desc_style((FAMILY, 20).into_font())
             .light_line_style(WHITE)
@@ -229,6 +247,10 @@ impl Figure for RngPicture<'_> {
                 .iter()
                 .map(|&p| Circle::new(p, 6, LANDMARK.filled())),
         )?;
+        let label_style = (FAMILY, 18).into_font().color(&RGBColor(0, 0, 0));
+        chart.draw_series(self.labels.iter().zip(self.landmarks).map(|(label, &p)| {
+            EmptyElement::at(p) + Text::new(label.clone(), (8, -20), label_style.clone())
+        }))?;
         Ok(())
     }
 }
@@ -243,11 +265,15 @@ mod tests {
     const EDGES: [(usize, usize, f64); 4] = [(0, 1, 0.0), (1, 2, 0.3), (2, 3, 1.0), (0, 2, 0.6)];
     const TRUE_EDGES: [(usize, usize); 4] = [(0, 1), (1, 2), (2, 3), (3, 0)];
     const STATIONS: [(f64, f64); 2] = [(1.0, 1.0), (3.0, 1.0)];
+    static LABELS: std::sync::LazyLock<Vec<String>> =
+        std::sync::LazyLock::new(|| ["0", "1", "2", "3"].map(String::from).to_vec());
 
     fn picture() -> RngPicture<'static> {
         RngPicture {
             title: "after image 2".into(),
             landmarks: &LANDMARKS,
+            labels: LABELS.as_slice(),
+            metric: true,
             edges: &EDGES,
             true_edges: &TRUE_EDGES,
             stations: &STATIONS,
@@ -277,6 +303,8 @@ mod tests {
         let lone = RngPicture {
             title: String::new(),
             landmarks: &LANDMARKS[..1],
+            labels: &[],
+            metric: false,
             edges: &[],
             true_edges: &[],
             stations: &[],
@@ -357,6 +385,13 @@ mod tests {
                     ..picture()
                 },
                 "too far apart",
+            ),
+            (
+                RngPicture {
+                    labels: &LABELS[..2],
+                    ..picture()
+                },
+                "2 labels for 4 landmarks",
             ),
         ];
         for (bad, reason) in cases {

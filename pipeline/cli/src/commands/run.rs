@@ -406,6 +406,7 @@ fn write_outputs(out: &Path, mapper: &Mapper<Edc>, records: &[StationRecord]) ->
         };
         let positions: Vec<(f64, f64)> =
             drawing.landmarks.iter().map(|l| (l.1[0], l.1[1])).collect();
+        let labels: Vec<String> = drawing.landmarks.iter().map(|l| l.0.to_string()).collect();
         let edges: Vec<(usize, usize, f64)> = drawing
             .edges
             .iter()
@@ -415,11 +416,14 @@ fn write_outputs(out: &Path, mapper: &Mapper<Edc>, records: &[StationRecord]) ->
             &out.join("rng.png"),
             &RngPicture {
                 title: format!(
-                    "RNG after {} stations ({} landmarks; graph layout, not metric)",
+                    "RNG after {} stations: {} landmarks, {} possible edges",
                     records.len(),
-                    positions.len()
+                    positions.len(),
+                    edges.len()
                 ),
                 landmarks: &positions,
+                labels: &labels,
+                metric: false,
                 edges: &edges,
                 true_edges: &[],
                 stations: &[],

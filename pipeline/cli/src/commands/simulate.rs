@@ -371,6 +371,7 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
                 (p.x, p.y)
             })
             .collect();
+        let labels: Vec<String> = map.landmarks().iter().map(u32::to_string).collect();
         let index = |id: u32| {
             map.landmarks()
                 .iter()
@@ -390,6 +391,8 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
             &RngPicture {
                 title: format!("RNG estimate after {} images", steps.len()),
                 landmarks: &landmarks,
+                labels: &labels,
+                metric: true,
                 edges: &edges,
                 true_edges: &true_edges,
                 stations: &stations,
