@@ -424,6 +424,39 @@ fn relation_is_consistent_over_all_six_orderings() {
     assert_eq!(map.relation(first, second, 123_456), None);
 }
 
+/// Landmarks added without relations (decided at a station that measured no triple) are
+/// universal to everything and leave even a fully determined map closed: it reads back from
+/// JSON, whose reader refuses any network that closing would change, and a later exact
+/// measurement of the new landmark fuses without contradiction.
+fn unrelated_landmarks<C: Calculus>(seed: u64) {
+    let mut rng = rng(seed);
+    let points = scene(&mut rng, 13);
+    let observations = exact::<C>(&points[..12]);
+    let mut map = Hypergraph::<C>::new();
+    map.fuse(&observations).unwrap();
+    map.add_landmarks(&[id(12), id(3), id(12)]);
+    assert_eq!(map.len(), 13);
+    assert!(map.contains(id(12)));
+    assert_eq!(map.relation(id(0), id(1), id(12)), Some(C::universe()));
+    let back = Hypergraph::<C>::from_json(&map.to_json()).expect("closed");
+    assert_eq!(back, map);
+    map.fuse(&exact::<C>(&points))
+        .expect("the truth is consistent");
+    assert_eq!(
+        map.relation(id(0), id(1), id(12)).map(|r| r.len()),
+        Some(1),
+        "measured now"
+    );
+}
+
+#[test]
+fn landmarks_without_relations_keep_the_map_closed() {
+    for seed in 0..3 {
+        unrelated_landmarks::<Edc>(seed);
+        unrelated_landmarks::<Fdc>(seed);
+    }
+}
+
 #[test]
 fn json_round_trip_is_loss_free() {
     let mut rng = rng(21);

@@ -106,6 +106,7 @@ fn maps_the_demo_dataset_soundly() {
     );
     assert!(score(&["association", "accuracy"]) >= 0.9, "{eval}");
     assert!(score(&["detection", "recall"]) >= 0.7, "{eval}");
+    assert_counts_agree(&out);
     assert!(
         eval["detection"]["precision"].as_f64().unwrap() >= 0.9,
         "{eval}"
@@ -123,6 +124,38 @@ fn maps_the_demo_dataset_soundly() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(json(&again.join("eval.json")), eval);
+}
+
+/// Every output that counts landmarks counts the same ones: map.json, landmarks.json,
+/// summary.json and eval.json (its association and its map), and the stations.
+fn assert_counts_agree(out: &Path) {
+    let map = json(&out.join("map.json"));
+    let landmarks = json(&out.join("landmarks.json"));
+    let summary = json(&out.join("summary.json"));
+    let eval = json(&out.join("eval.json"));
+    let stations = json(&out.join("stations.json"));
+    let n = map["landmarks"].as_array().unwrap().len() as u64;
+    assert_eq!(
+        landmarks.as_array().unwrap().len() as u64,
+        n,
+        "landmarks.json"
+    );
+    assert_eq!(summary["landmarks"].as_u64(), Some(n), "summary.json");
+    assert_eq!(
+        eval["association"]["landmarks"].as_u64(),
+        Some(n),
+        "eval association"
+    );
+    assert_eq!(
+        eval["map"]["run"]["landmarks"].as_u64(),
+        Some(n),
+        "eval map"
+    );
+    assert_eq!(
+        summary["stations"].as_u64(),
+        Some(stations.as_array().unwrap().len() as u64),
+        "stations"
+    );
 }
 
 /// Small rocks seen at half resolution are where association goes wrong (look-alikes a few
@@ -158,6 +191,7 @@ fn maps_half_resolution_surveys_soundly() {
             eval["association"]["accuracy"].as_f64().unwrap() >= 0.9,
             "{eval}"
         );
+        assert_counts_agree(&out);
     }
 }
 

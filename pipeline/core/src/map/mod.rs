@@ -100,6 +100,19 @@ impl<C: Calculus> Hypergraph<C> {
         Ok(tx.commit())
     }
 
+    /// Adds landmarks that no measurement relates yet, in order (ids the map holds are
+    /// skipped): every relation with them is the universe. A station that decides a new
+    /// landmark but measures no triple (it decided fewer than three) still makes it a
+    /// landmark of the run, which the map then lists like every other. Universal relations
+    /// keep the map closed: nothing composes with the universe to less than the universe.
+    pub fn add_landmarks(&mut self, ids: &[LandmarkId]) {
+        for &id in ids {
+            if !self.contains(id) {
+                self.push_landmark(id);
+            }
+        }
+    }
+
     /// Fuses another map over the same landmark id space: the result equals fusing both
     /// measurement streams. Landmarks of `other` not known here are appended in `other`'s
     /// order, every relation `other` knows is intersected in, and the map is closed. On a

@@ -236,6 +236,9 @@ impl<C: Calculus> Mapper<C> {
         match self.map.fuse(&batch) {
             Ok(report) => {
                 record.fusion.relations_tightened = report.relations_tightened;
+                // Without a triple, the landmarks decided here enter the map unrelated.
+                let decided: Vec<_> = associated.fused.iter().map(|s| s.landmark).collect();
+                self.map.add_landmarks(&decided);
                 self.next_landmark = associated.next_landmark;
                 self.remember(record, &associated);
                 self.hold_back(record, associated, view);
