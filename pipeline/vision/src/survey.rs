@@ -159,14 +159,9 @@ pub fn is_jpeg(path: &Path) -> bool {
     extension(path).is_some_and(|e| e == "jpg" || e == "jpeg")
 }
 
-/// The bit depth in a PNG file's header (`IHDR`), if `path` is a PNG file.
-fn png_bit_depth(path: &Path) -> Option<u8> {
-    use std::io::Read;
-    let mut header = [0u8; 26];
-    std::fs::File::open(path)
-        .ok()?
-        .read_exact(&mut header)
-        .ok()?;
+/// The bit depth in a PNG file's header (`IHDR`), if `bytes` are a PNG file's.
+fn png_bit_depth(bytes: &[u8]) -> Option<u8> {
+    let header = bytes.get(..26)?;
     (header[..8] == *b"\x89PNG\r\n\x1a\n" && header[12..16] == *b"IHDR").then_some(header[24])
 }
 
@@ -192,24 +187,38 @@ fn into_rgb(image: image::DynamicImage) -> RgbImage {
 /// per image and `stations.json` one per file read, so that scoring refuses a truth file
 /// written for other images, even ones of the same names and size.
 pub fn digest(path: &Path) -> std::io::Result<String> {
-    Ok(format!(
-        "crc32:{:08x}",
-        crc32fast::hash(&std::fs::read(path)?)
-    ))
+    Ok(digest_of(&std::fs::read(path)?))
+}
+
+/// [`digest`] of a file's bytes already read.
+fn digest_of(bytes: &[u8]) -> String {
+    format!("crc32:{:08x}", crc32fast::hash(bytes))
+}
+
+/// One panorama read: its pixels and its file's fingerprint ([`digest`]).
+pub struct Panorama {
+    pub image: RgbImage,
+    pub digest: String,
 }
 
 /// Reads one panorama as 8-bit RGB and checks its size against the calibration's.
 pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageError> {
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| ImageError::Decode {
-            path: path.to_path_buf(),
-            source: image::ImageError::IoError(e),
-        })?
-        .with_guessed_format()
-        .map_err(|e| ImageError::Decode {
-            path: path.to_path_buf(),
-            source: image::ImageError::IoError(e),
-        })?;
+    read_panorama(path, expected).map(|p| p.image)
+}
+
+/// [`read_image`], with the fingerprint of the bytes it decoded (the file is read once).
+pub fn read_panorama(path: &Path, expected: (u32, u32)) -> Result<Panorama, ImageError> {
+    let io_error = |e| ImageError::Decode {
+        path: path.to_path_buf(),
+        source: image::ImageError::IoError(e),
+    };
+    let bytes = std::fs::read(path).map_err(io_error)?;
+    // As `ImageReader::open`: the extension's format, unless the content says otherwise.
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes[..]));
+    if let Ok(format) = image::ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
+    let reader = reader.with_guessed_format().map_err(io_error)?;
     let decode_error = |source| ImageError::Decode {
         path: path.to_path_buf(),
         source,
@@ -217,7 +226,7 @@ pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageEr
     // A 1-, 2- or 4-bit panorama decodes to 8 bits, but with 2 to 16 levels the regolith's
     // shading and a rock's are one: the detector cannot use it. (The PNG decoder expands such
     // files without saying so; their header does.)
-    if let Some(bits) = png_bit_depth(path).filter(|&b| b < 8) {
+    if let Some(bits) = png_bit_depth(&bytes).filter(|&b| b < 8) {
         return Err(ImageError::Depth {
             path: path.to_path_buf(),
             bits,
@@ -233,7 +242,10 @@ pub fn read_image(path: &Path, expected: (u32, u32)) -> Result<RgbImage, ImageEr
             expected_height: expected.1,
         });
     }
-    Ok(image)
+    Ok(Panorama {
+        image,
+        digest: digest_of(&bytes),
+    })
 }
 
 fn stem(path: &Path) -> String {

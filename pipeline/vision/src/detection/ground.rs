@@ -102,7 +102,7 @@ pub(super) fn stances(
 
 /// Rows above and below a pixel that its stance depends on: the matching window's and the
 /// smoothing's.
-pub(super) const READ_ROWS: usize = RADIUS + 2 * SMOOTHING_PX as usize;
+pub(super) const READ_ROWS: usize = RADIUS + SMOOTHING_REACH;
 
 /// Columns a neighbourhood is shifted against itself to tell whether it is textured enough
 /// for the test: past [`TOLERANCE_COLUMNS`].
@@ -134,9 +134,13 @@ fn window_costs(a: &[f32], b: &[f32], width: usize, offset: isize) -> Vec<f32> {
 /// lossless image (marsyard seed 2 at quality 85).
 const SMOOTHING_PX: f32 = 1.0;
 
+/// Pixels the smoothing kernel reaches either side: two standard deviations hold 95 % of its
+/// weight.
+const SMOOTHING_REACH: usize = 2 * SMOOTHING_PX as usize;
+
 /// `band` (rows of `width`) smoothed by a Gaussian of [`SMOOTHING_PX`], wrapping at the seam.
 fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
-    let pad = (2.0 * SMOOTHING_PX).ceil() as usize;
+    let pad = SMOOTHING_REACH;
     let rows = band.len() / width;
     let padded_width = width + 2 * pad;
     let mut padded: Vec<f32> = Vec::with_capacity(padded_width * rows);
@@ -153,8 +157,7 @@ fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
     let blurred = Image::<f32, 1>::new(size, padded)
         .and_then(|src| {
             let mut dst = Image::<f32, 1>::from_size_val(size, 0.0)?;
-            // Two standard deviations either side hold 95 % of the kernel's weight.
-            let taps = 2 * (2.0 * SMOOTHING_PX).ceil() as usize + 1;
+            let taps = 2 * SMOOTHING_REACH + 1;
             gaussian_blur(&src, &mut dst, (taps, taps), (SMOOTHING_PX, SMOOTHING_PX))?;
             Ok(dst)
         })

@@ -6,7 +6,7 @@ use crate::calib::Calibration;
 use crate::detection::{detect, detect_right, Channels, DetectorSettings};
 use crate::ranging::PrimaryEye;
 use crate::run::StationDetections;
-use crate::survey::{digest, is_jpeg, read_image, Station};
+use crate::survey::{is_jpeg, read_panorama, Station};
 use std::path::Path;
 use std::time::Instant;
 
@@ -31,12 +31,12 @@ pub fn detect_station(
     let mut detect_seconds = 0.0;
     let mut timed_read = |path: &Path| {
         let start = Instant::now();
-        let image = read_image(path, size);
+        let panorama = read_panorama(path, size);
         decode_seconds += start.elapsed().as_secs_f64();
-        image
+        panorama
     };
     let primary = match timed_read(&station.primary) {
-        Ok(image) => image,
+        Ok(panorama) => panorama,
         Err(e) => {
             return FrontEndResult {
                 station: Err(format!("station {} skipped: {e}", station.name)),
@@ -50,7 +50,7 @@ pub fn detect_station(
         .right
         .as_ref()
         .and_then(|path| match timed_read(path) {
-            Ok(image) => Some(image),
+            Ok(panorama) => Some(panorama),
             Err(e) => {
                 warnings.push(format!(
                     "station {}: right panorama unusable, no stereo cue: {e}",
@@ -59,6 +59,17 @@ pub fn detect_station(
                 None
             }
         });
+    // The files read, with the fingerprints of the bytes decoded.
+    let (mut files, mut digests) = (vec![name(&station.primary)], vec![primary.digest]);
+    let right = match (station.right.as_deref(), right) {
+        (Some(path), Some(panorama)) => {
+            files.push(name(path));
+            digests.push(panorama.digest);
+            Some(panorama.image)
+        }
+        _ => None,
+    };
+    let primary = primary.image;
     let channels = settings
         .channels
         .resolve_file(&primary, right.is_some() && is_jpeg(&station.primary));
@@ -82,14 +93,6 @@ pub fn detect_station(
         .as_ref()
         .map(|r| detect_right(r, Some(&primary), calib, settings));
     detect_seconds += start.elapsed().as_secs_f64();
-    let mut paths = vec![station.primary.as_path()];
-    paths.extend(station.right.as_deref().filter(|_| right.is_some()));
-    let files = paths.iter().map(|p| name(p)).collect();
-    // A file that decoded a moment ago and cannot be read again has no fingerprint (empty).
-    let digests = paths
-        .iter()
-        .map(|p| digest(p).unwrap_or_default())
-        .collect();
     let eye = if station.right.is_some() || is_left_image(&station.primary) {
         PrimaryEye::Left
     } else {
