@@ -364,7 +364,7 @@ struct AssociationMessage<'a> {
 #[derive(Serialize)]
 struct Decision<'a> {
     detection: usize,
-    /// Adds `decision` and, by decision, `landmark` or `candidates`.
+    /// Adds `decision` and, by decision, `landmark`, `candidates` or the `reason` it is unused.
     #[serde(flatten)]
     association: &'a Association,
 }

@@ -175,7 +175,7 @@ fn association_label(association: &Association) -> String {
         Association::Matched { landmark } => format!("L{landmark}"),
         Association::New { landmark } => format!("new L{landmark}"),
         Association::HeldBack { .. } => "held".to_string(),
-        Association::Unused => "unused".to_string(),
+        Association::Unused { .. } => "unused".to_string(),
     }
 }
 
@@ -184,7 +184,7 @@ fn association_colour(association: &Association) -> rerun::Color {
         Association::Matched { .. } => rerun::Color::from_rgb(40, 200, 40),
         Association::New { .. } => rerun::Color::from_rgb(40, 140, 255),
         Association::HeldBack { .. } => rerun::Color::from_rgb(255, 170, 0),
-        Association::Unused => rerun::Color::from_rgb(150, 150, 150),
+        Association::Unused { .. } => rerun::Color::from_rgb(150, 150, 150),
     }
 }
 

@@ -62,7 +62,7 @@ fn station(index: usize) -> StationRecord {
                     2 => Association::HeldBack {
                         candidates: vec![3, 5],
                     },
-                    _ => Association::Unused,
+                    _ => Association::default(),
                 },
             }
         })

@@ -67,7 +67,7 @@ impl Tally {
     fn add_bearing(&mut self, d: &DetectionRecord, truth: f64) {
         let error = angle_error(d.bearing, truth);
         self.bearing_errors.push(error);
-        if d.association != Association::Unused {
+        if !matches!(d.association, Association::Unused { .. }) {
             self.used_errors.push((error, d.bearing_uncertainty));
         }
         if error <= d.bearing_uncertainty {

@@ -140,7 +140,13 @@ impl<C: Calculus> Mapper<C> {
             .primary
             .iter()
             .zip(&ranged)
-            .map(|(d, r)| detection_record(d, r))
+            .enumerate()
+            .map(|(i, (d, r))| DetectionRecord {
+                association: Association::Unused {
+                    reason: selection::exclusion(station, &ranged, i, self.calib.image.width),
+                },
+                ..detection_record(d, r)
+            })
             .collect();
         record.fusion.usable = usable.len();
         if usable.len() < 3 {
@@ -441,7 +447,7 @@ fn detection_record(d: &Detection, r: &Ranged) -> DetectionRecord {
             fused: r.fused.as_array(),
             conflict: r.conflict,
         },
-        association: Association::Unused,
+        association: Association::default(),
     }
 }
 

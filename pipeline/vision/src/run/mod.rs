@@ -15,6 +15,6 @@ pub use traverse::{
 };
 
 pub use record::{
-    Association, DetectionRecord, FusionRecord, MetricsRecord, RangeRecord, StageSeconds,
-    StationRecord,
+    Association, DetectionRecord, Exclusion, FusionRecord, MetricsRecord, RangeRecord,
+    StageSeconds, StationRecord,
 };

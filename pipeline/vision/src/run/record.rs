@@ -77,7 +77,7 @@ pub struct RangeRecord {
 }
 
 /// What data association decided for one detection (000 §VI-C).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "decision", rename_all = "snake_case")]
 pub enum Association {
     /// The detection is map landmark `landmark`.
@@ -86,9 +86,37 @@ pub enum Association {
     New { landmark: u32 },
     /// Several landmarks remain possible: the observation is held back.
     HeldBack { candidates: Vec<u32> },
-    /// Not used for mapping (e.g. the panorama was rejected).
-    #[default]
-    Unused,
+    /// Not used for mapping: `reason` says why, absent when the detection was usable but its
+    /// panorama added nothing (fewer than three usable detections, or the map rejected it).
+    Unused {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        reason: Option<Exclusion>,
+    },
+}
+
+impl Default for Association {
+    fn default() -> Association {
+        Association::Unused { reason: None }
+    }
+}
+
+/// Why mapping leaves a detection out (`selection::exclusion`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Exclusion {
+    /// Behind a nearer rock it was told apart from by parallax, which may hide some of it.
+    Behind,
+    /// The detector doubts it is one whole rock: a piece cut at a shallow notch, a top
+    /// without its body, or no stereo to tell it from a shadow.
+    Doubted,
+    /// Narrower than a 512th of the view: mostly pieces of larger rocks.
+    Sliver,
+    /// Taller than wide: a farther rock seen over a nearer one.
+    Stacked,
+    /// Its box meets another detection's: two rocks, or one rock in two pieces.
+    Touching,
+    /// Its bearing interval is too wide to measure with.
+    WideBearing,
 }
 
 /// The outcome of fusing one panorama.

@@ -2,6 +2,7 @@
 //! selection policy of `pipeline run`, in one place.
 
 use super::mapper::StationDetections;
+use super::record::Exclusion;
 use crate::association::{Evidence, Placed, StationEvidence};
 use crate::detection::{Channels, Detection, Separation};
 use crate::ranging::{self, RangeInterval, Ranged, SensorModel};
@@ -17,21 +18,38 @@ const MIN_COLUMNS: u32 = 3;
 /// nearer rock's) and centroid (between the two) belong to neither.
 const MAX_ASPECT: f64 = 1.5;
 
-/// The indices of the detections mapping can use. Detections the detector doubts (possibly
-/// several rocks, or part of one), slivers, pieces touching another piece, stacks, and those
-/// whose bearing is too uncertain to measure with are left out.
+/// The indices of the detections mapping can use: those [`exclusion`] keeps.
 pub(super) fn usable(station: &StationDetections, ranged: &[Ranged], width: u32) -> Vec<usize> {
-    let narrowest = MIN_COLUMNS.max(width / 512);
     (0..ranged.len())
-        .filter(|&i| {
-            let d = &station.primary[i];
-            !d.ambiguous
-                && d.bbox[2] + 1 >= d.bbox[0] + narrowest
-                && !stacked(d)
-                && !ranging::touches_neighbour(i, &station.primary, width)
-                && ranged[i].bearing.uncertainty < MAX_BEARING_UNCERTAINTY
-        })
+        .filter(|&i| exclusion(station, ranged, i, width).is_none())
         .collect()
+}
+
+/// Why mapping leaves detection `i` out, if it does: detections the detector doubts (possibly
+/// several rocks, or part of one), slivers, stacks, pieces touching another piece, and those
+/// whose bearing is too uncertain to measure with.
+pub(super) fn exclusion(
+    station: &StationDetections,
+    ranged: &[Ranged],
+    i: usize,
+    width: u32,
+) -> Option<Exclusion> {
+    let d = &station.primary[i];
+    if d.ambiguous && d.separation == Separation::Farther {
+        Some(Exclusion::Behind)
+    } else if d.ambiguous {
+        Some(Exclusion::Doubted)
+    } else if d.bbox[2] + 1 < d.bbox[0] + MIN_COLUMNS.max(width / 512) {
+        Some(Exclusion::Sliver)
+    } else if stacked(d) {
+        Some(Exclusion::Stacked)
+    } else if ranging::touches_neighbour(i, &station.primary, width) {
+        Some(Exclusion::Touching)
+    } else if ranged[i].bearing.uncertainty >= MAX_BEARING_UNCERTAINTY {
+        Some(Exclusion::WideBearing)
+    } else {
+        None
+    }
 }
 
 fn stacked(d: &Detection) -> bool {
@@ -97,4 +115,94 @@ pub(super) fn view_of(ranged: &[Ranged], usable: &[usize]) -> StationView {
     let order: RangeOrder = ranging::range_order(&chosen);
     StationView::new(bearings, order)
         .expect("bearings are finite, in range, with uncertainty below the limit")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::detection::Appearance;
+    use crate::ranging::PrimaryEye;
+
+    fn detection(bbox: [u32; 4], ambiguous: bool, separation: Separation) -> Detection {
+        Detection {
+            centroid: [
+                f64::from(bbox[0] + bbox[2]) / 2.0,
+                f64::from(bbox[1] + bbox[3]) / 2.0,
+            ],
+            bbox,
+            pixels: 100,
+            contact_row: f64::from(bbox[3] + 1),
+            contact_slack_rows: 0.0,
+            appearance: Appearance {
+                colour: [0.4, 0.33, 0.27],
+                brightness: 0.8,
+                texture: 0.1,
+                dark_fraction: 0.2,
+            },
+            ambiguous,
+            separation,
+            blob: 0,
+            beyond_columns: [0, 0],
+        }
+    }
+
+    fn ranged(uncertainty: f64) -> Ranged {
+        Ranged {
+            bearing: Bearing {
+                angle: 1.0,
+                uncertainty,
+            },
+            stereo_column: None,
+            angular_width: 0.01,
+            ground: None,
+            stereo: None,
+            size: None,
+            fused: RangeInterval::new(4.0, 5.0),
+            conflict: false,
+        }
+    }
+
+    /// Each detection left out says why, and only those left out are not usable.
+    #[test]
+    fn every_left_out_detection_has_its_reason() {
+        let primary = vec![
+            detection([100, 50, 130, 70], false, Separation::Whole),
+            detection([300, 50, 330, 70], true, Separation::Farther),
+            detection([500, 50, 530, 70], true, Separation::Whole),
+            detection([700, 50, 701, 70], false, Separation::Whole),
+            detection([900, 10, 910, 70], false, Separation::Whole),
+            detection([1100, 50, 1130, 70], false, Separation::Whole),
+            detection([1131, 55, 1160, 75], false, Separation::Whole),
+            detection([1300, 50, 1330, 70], false, Separation::Whole),
+        ];
+        let mut all: Vec<Ranged> = (0..primary.len()).map(|_| ranged(0.01)).collect();
+        all[7] = ranged(MAX_BEARING_UNCERTAINTY);
+        let station = StationDetections {
+            name: "s".into(),
+            files: Vec::new(),
+            digests: Vec::new(),
+            eye: PrimaryEye::Mono,
+            channels: Channels::Colour,
+            primary,
+            right: None,
+            warnings: Vec::new(),
+        };
+        let reasons: Vec<Option<Exclusion>> = (0..all.len())
+            .map(|i| exclusion(&station, &all, i, 4096))
+            .collect();
+        assert_eq!(
+            reasons,
+            [
+                None,
+                Some(Exclusion::Behind),
+                Some(Exclusion::Doubted),
+                Some(Exclusion::Sliver),
+                Some(Exclusion::Stacked),
+                Some(Exclusion::Touching),
+                Some(Exclusion::Touching),
+                Some(Exclusion::WideBearing),
+            ]
+        );
+        assert_eq!(usable(&station, &all, 4096), [0]);
+    }
 }
