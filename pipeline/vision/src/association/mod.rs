@@ -32,6 +32,7 @@
 
 mod gallery;
 mod registration;
+mod significance;
 pub mod sketch;
 
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
