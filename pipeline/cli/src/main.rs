@@ -78,6 +78,10 @@ enum Command {
     /// Inspect or merge saved maps (JSON, docs/MAP_FORMAT.md).
     #[command(subcommand)]
     Map(commands::map::MapCommand),
+    /// Navigate over a map's RNG (000 §VII-B): landmark routes, the convex hull, and simulated
+    /// navigation with an ideal sensor (docs/NAVIGATION.md).
+    #[command(subcommand)]
+    Navigate(commands::navigate::NavigateCommand),
     /// Render a synthetic dataset: stereo panoramas of a rock field with ground truth
     /// (datasets/README.md), e.g. `synth --preset marsyard --seed 1 --out data/marsyard`.
     Synth(commands::synth::SynthArgs),
@@ -215,6 +219,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Measure(args) => commands::measure::run(args)?,
         Command::Simulate(command) => commands::simulate::run_command(command)?,
         Command::Map(command) => commands::map::run_command(command)?,
+        Command::Navigate(command) => commands::navigate::run_command(command)?,
         Command::Synth(args) => commands::synth::run(args)?,
         Command::Run(args) => commands::run::run(args)?,
         Command::Eval(args) => commands::eval::run(args)?,

@@ -54,5 +54,6 @@ pub mod geometry;
 pub mod map;
 pub mod measurement;
 pub mod metrics;
+pub mod navigation;
 pub mod neighborhood;
 pub mod simulation;

@@ -25,6 +25,8 @@ pub(super) enum Key {
     Dashed(RGBColor),
     /// A filled circle marker.
     Circle(RGBColor),
+    /// An open circle marker.
+    Ring(RGBColor),
     /// A filled triangle marker.
     Triangle(RGBColor),
     /// The edge-cost colours for `0 < w ≤ 1`.
@@ -153,6 +155,7 @@ fn draw_swatch<DB: DrawingBackend>(
             area.draw(&DashedPathElement::new(line, 6, 4, colour.stroke_width(2)))
         }
         Key::Circle(colour) => area.draw(&Circle::new(middle, 6, colour.filled())),
+        Key::Ring(colour) => area.draw(&Circle::new(middle, 6, colour.stroke_width(2))),
         Key::Triangle(colour) => area.draw(&TriangleMarker::new(middle, 9, colour.filled())),
         Key::CostScale => {
             for step in 0..SCALE_WIDTH {

@@ -8,6 +8,7 @@
 
 mod cost_colour;
 mod error;
+mod flow;
 mod font;
 mod layout;
 mod legend;
@@ -18,6 +19,7 @@ mod rng;
 mod ticks;
 
 pub use error::PlotError;
+pub use flow::{write_flow, FlowPicture};
 pub use layout::spring_layout;
 pub use panels::{write_panels, Curve, Panel};
 pub use rng::{write_rng, RngPicture};

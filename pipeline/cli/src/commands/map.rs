@@ -30,7 +30,7 @@ pub enum MapCommand {
 }
 
 /// The `calculus` field of a map file, to pick the type to load it as.
-fn calculus_of(path: &Path, text: &str) -> Result<String> {
+pub(super) fn calculus_of(path: &Path, text: &str) -> Result<String> {
     let value: serde_json::Value =
         serde_json::from_str(text).with_context(|| format!("{} is not JSON", path.display()))?;
     match value.get("calculus").and_then(|c| c.as_str()) {
@@ -42,11 +42,11 @@ fn calculus_of(path: &Path, text: &str) -> Result<String> {
     }
 }
 
-fn read(path: &Path) -> Result<String> {
+pub(super) fn read(path: &Path) -> Result<String> {
     std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
 }
 
-fn load<C: Calculus>(path: &Path, text: &str) -> Result<Hypergraph<C>> {
+pub(super) fn load<C: Calculus>(path: &Path, text: &str) -> Result<Hypergraph<C>> {
     Hypergraph::<C>::from_json(text).with_context(|| format!("invalid map {}", path.display()))
 }
 

@@ -3,6 +3,7 @@
 pub mod eval;
 pub mod map;
 pub mod measure;
+pub mod navigate;
 pub mod output;
 pub mod run;
 pub mod simulate;

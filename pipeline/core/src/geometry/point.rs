@@ -2,7 +2,9 @@ use std::ops::{Add, Sub};
 
 /// A point whose coordinates are numbers (`f64`, exact rationals) or symbolic affine
 /// expressions in unknowns (for building feasibility constraints).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
+)]
 pub struct Point2<T> {
     pub x: T,
     pub y: T,

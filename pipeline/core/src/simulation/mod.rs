@@ -4,10 +4,16 @@
 
 mod mapping;
 mod montecarlo;
+mod navigation;
+mod navigation_study;
 mod scenario;
 mod sensor;
 
 pub use mapping::{run, Step};
 pub use montecarlo::{MonteCarlo, MonteCarloResult, Series, Statistic};
+pub use navigation::{drive, nearest, Drive, Leg, Outcome, Trip};
+pub use navigation_study::{
+    jittered_grid, Layout, NavigationStudy, NavigationSummary, RngSource, TripRecord,
+};
 pub use scenario::Scenario;
 pub use sensor::Sensor;

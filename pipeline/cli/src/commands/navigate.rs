@@ -1,0 +1,465 @@
+//! `pipeline navigate`: landmark routes and the convex hull from a saved map, and simulated
+//! navigation over the RNG (000 §VII-B; seed digest A).
+
+use super::map::{calculus_of, load, read};
+use super::output::write_atomic;
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use qrm_core::calculus::Calculus;
+use qrm_core::edc::Edc;
+use qrm_core::fdc::Fdc;
+use qrm_core::geometry::Point;
+use qrm_core::map::{Hypergraph, LandmarkId};
+use qrm_core::navigation::{convex_hull, Command, LegFollower, RouteCost, RouteGraph};
+use qrm_core::neighborhood::{estimate, true_rng};
+use qrm_core::simulation::{
+    drive, nearest, Drive, Layout, NavigationStudy, NavigationSummary, RngSource, Sensor,
+    TripRecord,
+};
+use qrm_plot::{write_flow, FlowPicture};
+use rand::SeedableRng;
+use std::fmt::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Subcommand, Debug)]
+pub enum NavigateCommand {
+    /// The landmark route from one landmark to another over the map's RNG estimate, e.g.
+    /// `navigate plan --map run/map.json --from 3 --to 17`. Pruned pairs are never used; each
+    /// edge costs 1 + λ·w (w: the edge's Algorithm 2 cost, 0 for an edge the map proves), so
+    /// with λ > 0 edges the map may yet prune are avoided when a route of certain edges is not
+    /// much longer.
+    Plan(PlanArgs),
+    /// The convex hull of the map's landmarks: the edges the map proves, and those it allows.
+    Hull {
+        #[arg(long)]
+        map: PathBuf,
+    },
+    /// Simulated navigation with an ideal sensor (bearings and range order of the landmarks,
+    /// no rendering): random fields, random start/goal pairs, the leg follower of 000 §VII-B
+    /// planning on the true RNG or on the RNG of a map after `--images` simulated panoramas.
+    /// Writes trips.csv, summary.json and a figure like 000 Fig. 6 (flowfield.png/.svg).
+    Simulate(SimulateArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct PlanArgs {
+    /// A saved EDC map (`pipeline run`'s map.json, docs/MAP_FORMAT.md).
+    #[arg(long)]
+    map: PathBuf,
+    /// Landmark id to start from (the one whose cell the rover is in).
+    #[arg(long)]
+    from: LandmarkId,
+    /// Landmark id to reach.
+    #[arg(long)]
+    to: LandmarkId,
+    /// Weight λ of an edge's RNG cost against one hop.
+    #[arg(long, default_value_t = 1.0)]
+    lambda: f64,
+    /// How many routes to list, cheapest first (alternatives for when a leg fails).
+    #[arg(long, default_value_t = 1)]
+    routes: usize,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum LayoutName {
+    /// Landmarks uniform in the square (000 §VIII-B).
+    Uniform,
+    /// One landmark per grid cell, jittered by `--jitter` of the cell side.
+    Grid,
+}
+
+#[derive(Args, Debug)]
+pub struct SimulateArgs {
+    /// Random landmark fields.
+    #[arg(long, default_value_t = 10)]
+    worlds: usize,
+    #[arg(long, default_value_t = 30)]
+    landmarks: usize,
+    /// Start/goal pairs per field.
+    #[arg(long, default_value_t = 100)]
+    pairs: usize,
+    /// Side of the square field.
+    #[arg(long, default_value_t = 100.0)]
+    side: f64,
+    #[arg(long, value_enum, default_value = "uniform")]
+    layout: LayoutName,
+    /// Jitter of the grid layout, as a fraction of a cell's side.
+    #[arg(long, default_value_t = 0.3)]
+    jitter: f64,
+    /// Plan on the RNG estimated from an EDC map of this many simulated panoramas (exact
+    /// sensing) instead of the true RNG.
+    #[arg(long)]
+    images: Option<usize>,
+    /// Landmarks each mapping panorama sees (the n nearest; default all).
+    #[arg(long)]
+    nearest: Option<usize>,
+    /// Landmarks the rover sees while driving (the n nearest; default all, the guarantee's
+    /// case: "landmarks visible from adjacent cells").
+    #[arg(long)]
+    visible: Option<usize>,
+    /// Weight λ of an edge's RNG cost against one hop.
+    #[arg(long, default_value_t = 1.0)]
+    lambda: f64,
+    /// Step length, as a fraction of the side (seed digest A.7: 0.5 %).
+    #[arg(long, default_value_t = 0.005)]
+    step: f64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output directory.
+    #[arg(long, default_value = "navigation")]
+    out: PathBuf,
+}
+
+pub fn run_command(command: NavigateCommand) -> Result<()> {
+    match command {
+        NavigateCommand::Plan(args) => plan(&args),
+        NavigateCommand::Hull { map } => {
+            let text = read(&map)?;
+            match calculus_of(&map, &text)?.as_str() {
+                "EDC" => hull(&load::<Edc>(&map, &text)?),
+                "FDC" => hull(&load::<Fdc>(&map, &text)?),
+                other => bail!("{}: unknown calculus {other:?}", map.display()),
+            }
+        }
+        NavigateCommand::Simulate(args) => simulate(&args),
+    }
+}
+
+fn plan(args: &PlanArgs) -> Result<()> {
+    if !(args.lambda >= 0.0 && args.lambda.is_finite()) {
+        bail!("--lambda {} must be a finite number ≥ 0", args.lambda);
+    }
+    if args.routes == 0 {
+        bail!("--routes must be at least 1");
+    }
+    let text = read(&args.map)?;
+    let calculus = calculus_of(&args.map, &text)?;
+    if calculus != "EDC" {
+        bail!(
+            "{}: a {calculus} map has no RNG estimate (only EDC tells distances apart); map with --calculus edc",
+            args.map.display()
+        );
+    }
+    let map: Hypergraph<Edc> = load(&args.map, &text)?;
+    let rng = estimate(&map).expect("EDC has a lune");
+    let graph = RouteGraph::new(map.landmarks(), &rng);
+    let cost = RouteCost {
+        lambda: args.lambda,
+    };
+    let routes = graph
+        .alternatives(args.from, args.to, cost, args.routes)
+        .with_context(|| format!("in {}", args.map.display()))?;
+    for (k, route) in routes.iter().enumerate() {
+        let names: Vec<String> = route.landmarks.iter().map(|l| l.to_string()).collect();
+        println!(
+            "route {}: {}  ({} hops, {} not proven by the map, cost {:.3})",
+            k + 1,
+            names.join(" → "),
+            route.hops(),
+            route.uncertain_edges,
+            route.cost
+        );
+    }
+    if routes.len() < args.routes {
+        println!("(no other loopless route)");
+    }
+    Ok(())
+}
+
+fn hull<C: Calculus>(map: &Hypergraph<C>) -> Result<()> {
+    let hull = convex_hull(map);
+    let list = |edges: &[(LandmarkId, LandmarkId)]| {
+        edges
+            .iter()
+            .map(|(a, b)| format!("{a}–{b}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    println!(
+        "{} map, {} landmarks: {} hull edges proven, {} more possible",
+        C::NAME,
+        map.len(),
+        hull.certain.len(),
+        hull.possible.len()
+    );
+    if !hull.certain.is_empty() {
+        println!("proven: {}", list(&hull.certain));
+        let on: Vec<String> = hull
+            .certain_landmarks()
+            .iter()
+            .map(|l| l.to_string())
+            .collect();
+        println!("landmarks certainly on the hull: {}", on.join(", "));
+    }
+    if !hull.possible.is_empty() {
+        println!("possible: {}", list(&hull.possible));
+    }
+    Ok(())
+}
+
+fn study(args: &SimulateArgs) -> Result<NavigationStudy> {
+    if args.worlds == 0 || args.pairs == 0 {
+        bail!("--worlds and --pairs must be positive");
+    }
+    if args.landmarks < 3 {
+        bail!("--landmarks must be at least 3");
+    }
+    if !(args.side > 0.0 && args.side.is_finite()) {
+        bail!("--side {} must be a positive length", args.side);
+    }
+    if !(args.step > 0.0 && args.step < 0.5) {
+        bail!(
+            "--step {} must be a fraction of the side in (0, 0.5)",
+            args.step
+        );
+    }
+    if !(0.0..0.5).contains(&args.jitter) {
+        bail!("--jitter {} must lie in [0, 0.5)", args.jitter);
+    }
+    if !(args.lambda >= 0.0 && args.lambda.is_finite()) {
+        bail!("--lambda {} must be a finite number ≥ 0", args.lambda);
+    }
+    if args.nearest.is_some_and(|n| n < 3) || args.visible.is_some_and(|n| n < 1) {
+        bail!("--nearest must be at least 3 and --visible at least 1");
+    }
+    let step = args.step * args.side;
+    Ok(NavigationStudy {
+        worlds: args.worlds,
+        landmarks: args.landmarks,
+        pairs: args.pairs,
+        side: args.side,
+        layout: match args.layout {
+            LayoutName::Uniform => Layout::Uniform,
+            LayoutName::Grid => Layout::JitteredGrid {
+                jitter: args.jitter,
+            },
+        },
+        source: match args.images {
+            None => RngSource::True,
+            Some(images) => RngSource::Mapped {
+                images,
+                nearest: args.nearest,
+            },
+        },
+        drive: Drive {
+            step,
+            // Ten times the longest straight crossing of the field.
+            max_steps: (10.0 * std::f64::consts::SQRT_2 / args.step).ceil() as usize,
+            max_replans: 5,
+            sensor: Sensor::exact(args.visible),
+            cost: RouteCost {
+                lambda: args.lambda,
+            },
+        },
+        seed: args.seed,
+    })
+}
+
+fn simulate(args: &SimulateArgs) -> Result<()> {
+    let study = study(args)?;
+    let bar = ProgressBar::new(study.worlds as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} fields [{bar:40}] {pos}/{len} ({elapsed}, eta {eta})",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    let start = Instant::now();
+    let records = study.run(&|| bar.inc(1));
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    let summary = NavigationSummary::of(&records);
+    write_atomic(&args.out.join("trips.csv"), trips_csv(&records).as_bytes())?;
+    let json = serde_json::json!({
+        "format": "qrm-navigation-study",
+        "version": 1,
+        "worlds": study.worlds,
+        "landmarks": study.landmarks,
+        "pairs": study.pairs,
+        "side": study.side,
+        "layout": study.layout,
+        "rng": study.source,
+        "lambda": study.drive.cost.lambda,
+        "step": study.drive.step,
+        "visible": args.visible,
+        "seed": study.seed,
+        "seconds": seconds,
+        "summary": summary,
+    });
+    write_atomic(
+        &args.out.join("summary.json"),
+        (serde_json::to_string_pretty(&json).expect("JSON values serialise") + "\n").as_bytes(),
+    )?;
+    for name in ["flowfield.png", "flowfield.svg"] {
+        write_flow(&args.out.join(name), &flow_picture(&study)?)?;
+    }
+    print!("{}", summary_text(&study, &summary, seconds));
+    println!(
+        "wrote {}/trips.csv, summary.json, flowfield.png, flowfield.svg",
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn trips_csv(records: &[TripRecord]) -> String {
+    let mut out = String::from(
+        "world,pair,outcome,length_ratio,length,straight,route_hops,legs,replans,steps\n",
+    );
+    for r in records {
+        let outcome = serde_json::to_value(r.outcome).expect("outcome serialises");
+        let _ = writeln!(
+            out,
+            "{},{},{},{:.4},{:.3},{:.3},{},{},{},{}",
+            r.world,
+            r.pair,
+            outcome.as_str().unwrap_or("?"),
+            r.length_ratio,
+            r.length,
+            r.straight,
+            r.route_hops,
+            r.legs,
+            r.replans,
+            r.steps
+        );
+    }
+    out
+}
+
+fn summary_text(study: &NavigationStudy, s: &NavigationSummary, seconds: f64) -> String {
+    let source = match study.source {
+        RngSource::True => "the true RNG".to_string(),
+        RngSource::Mapped { images, nearest } => format!(
+            "the RNG estimate after {images} images ({} landmarks each)",
+            nearest.map_or("all".to_string(), |n| n.to_string())
+        ),
+    };
+    let outcomes: Vec<String> = s.outcomes.iter().map(|(k, v)| format!("{k} {v}")).collect();
+    format!(
+        "{} trips over {} fields of {} landmarks, planning on {source} (λ = {}):\n  \
+         success {:.1} %  ({})\n  path length / straight distance: median {:.3}, 90th percentile {:.3}\n  \
+         mean legs {:.2}, mean re-plans {:.2}; {:.1} s\n",
+        s.trips,
+        study.worlds,
+        study.landmarks,
+        study.drive.cost.lambda,
+        100.0 * s.success_rate,
+        outcomes.join(", "),
+        s.median_length_ratio,
+        s.p90_length_ratio,
+        s.mean_legs,
+        s.mean_replans,
+        seconds
+    )
+}
+
+/// 000 Fig. 6 for the study's first field: Voronoi borders, the RNG planned on, the direction
+/// the leg follower takes at each point of a grid toward the cell of the landmark nearest one
+/// goal, and three trips from random starts.
+fn flow_picture(study: &NavigationStudy) -> Result<FlowPicture> {
+    let points = study.world(0);
+    let graph = study.graph(0, &points);
+    let pairs = study.pairs_of(0);
+    let goal = pairs[0].1;
+    let goal_landmark = nearest(&points, goal);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(study.seed);
+    let trips: Vec<Vec<(f64, f64)>> = pairs
+        .iter()
+        .take(3)
+        .map(|&(start, _)| {
+            let trip = drive(&points, &graph, start, goal, &study.drive, &mut rng);
+            trip.path.iter().map(|p| (p.x, p.y)).collect()
+        })
+        .collect();
+    let arrows = flow_arrows(study, &points, &graph, goal_landmark);
+    let edges: Vec<(usize, usize, f64)> = (0..points.len() as LandmarkId)
+        .flat_map(|a| {
+            graph
+                .neighbours(a)
+                .into_iter()
+                .filter(move |&(b, _)| a < b)
+                .map(move |(b, w)| (a as usize, b as usize, w.clamp(0.0, 1.0)))
+        })
+        .collect();
+    let true_edges = match study.source {
+        RngSource::True => Vec::new(),
+        RngSource::Mapped { .. } => true_rng(&points),
+    };
+    Ok(FlowPicture {
+        title: format!(
+            "000 Fig. 6 flow field · {}",
+            match study.source {
+                RngSource::True => "true RNG".to_string(),
+                RngSource::Mapped { images, .. } => format!("RNG estimate after {images} images"),
+            }
+        ),
+        landmarks: points.iter().map(|p| (p.x, p.y)).collect(),
+        edges,
+        true_edges,
+        arrows,
+        goal: (goal.x, goal.y),
+        trips,
+        side: study.side,
+    })
+}
+
+/// At the centre of each cell of a 20 × 20 grid, the direction the leg follower drives on a
+/// route planned from the landmark whose cell the point is in (000 Fig. 6's red arrows).
+fn flow_arrows(
+    study: &NavigationStudy,
+    points: &[Point],
+    graph: &RouteGraph,
+    goal: LandmarkId,
+) -> Vec<((f64, f64), (f64, f64))> {
+    let cells = 20;
+    let spacing = study.side / f64::from(cells);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(study.seed);
+    let mut arrows = Vec::new();
+    for i in 0..cells {
+        for j in 0..cells {
+            let p = Point::new(
+                (f64::from(i) + 0.5) * spacing,
+                (f64::from(j) + 0.5) * spacing,
+            );
+            let (visible, view) = Sensor::exact(None).observe(points, p, &mut rng);
+            let Ok(route) = graph.plan(nearest(points, p), goal, study.drive.cost) else {
+                continue;
+            };
+            if let Command::Toward { bearing, .. } = LegFollower::new(&route).step(&visible, &view)
+            {
+                arrows.push(((p.x, p.y), (bearing.cos(), bearing.sin())));
+            }
+        }
+    }
+    arrows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_csv_has_a_row_per_trip() {
+        let records = vec![TripRecord {
+            world: 0,
+            pair: 3,
+            outcome: qrm_core::simulation::Outcome::Arrived,
+            length_ratio: 1.25,
+            length: 50.0,
+            straight: 40.0,
+            route_hops: 3,
+            legs: 3,
+            replans: 0,
+            steps: 100,
+        }];
+        let csv = trips_csv(&records);
+        assert_eq!(csv.lines().count(), 2);
+        assert!(csv
+            .lines()
+            .nth(1)
+            .unwrap()
+            .starts_with("0,3,arrived,1.2500,"));
+    }
+}

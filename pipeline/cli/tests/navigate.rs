@@ -1,0 +1,164 @@
+//! `navigate`: routes and the hull of a saved map, the simulation's outputs, and clear errors
+//! for landmarks the map lacks, maps without an RNG and bad options.
+
+use super::pipeline;
+use std::path::Path;
+
+fn stdout(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stdout).to_string()
+}
+
+/// A simulated EDC map of 8 landmarks in `dir`, and the same as FDC.
+fn maps(dir: &Path) {
+    for (calculus, sub) in [("edc", "edc"), ("fdc", "fdc")] {
+        let o = pipeline(&[
+            "simulate",
+            "single",
+            "--landmarks",
+            "8",
+            "--stations",
+            "20",
+            "--calculus",
+            calculus,
+            "--out",
+            dir.join(sub).to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+}
+
+#[test]
+fn plans_routes_and_reads_the_hull_of_a_saved_map() {
+    let scratch = tempfile::tempdir().unwrap();
+    maps(scratch.path());
+    let edc = scratch.path().join("edc/map.json");
+    let edc = edc.to_str().unwrap();
+    let o = pipeline(&[
+        "navigate", "plan", "--map", edc, "--from", "0", "--to", "7", "--routes", "3",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = stdout(&o);
+    assert!(text.starts_with("route 1: 0 → "), "{text}");
+    assert!(text.lines().next().unwrap().contains(" → 7  ("), "{text}");
+    assert!(text.contains("route 2: "), "{text}");
+    for map in [edc, scratch.path().join("fdc/map.json").to_str().unwrap()] {
+        let o = pipeline(&["navigate", "hull", "--map", map]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(stdout(&o).contains("hull edges proven"), "{}", stdout(&o));
+    }
+    let fdc = scratch.path().join("fdc/map.json");
+    for (bad, says) in [
+        (
+            vec![
+                "navigate", "plan", "--map", edc, "--from", "0", "--to", "99",
+            ],
+            "landmark 99 is not in the map",
+        ),
+        (
+            vec![
+                "navigate", "plan", "--map", edc, "--from", "0", "--to", "1", "--routes", "0",
+            ],
+            "--routes",
+        ),
+        (
+            vec![
+                "navigate",
+                "plan",
+                "--map",
+                edc,
+                "--from",
+                "0",
+                "--to",
+                "1",
+                "--lambda=-1",
+            ],
+            "--lambda",
+        ),
+        (
+            vec![
+                "navigate",
+                "plan",
+                "--map",
+                fdc.to_str().unwrap(),
+                "--from",
+                "0",
+                "--to",
+                "1",
+            ],
+            "no RNG estimate",
+        ),
+        (
+            vec![
+                "navigate",
+                "plan",
+                "--map",
+                "/nonexistent/map.json",
+                "--from",
+                "0",
+                "--to",
+                "1",
+            ],
+            "cannot read",
+        ),
+    ] {
+        let o = pipeline(&bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            stderr.starts_with("error: ") && stderr.contains(says),
+            "{bad:?}: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn simulates_navigation_and_writes_its_outputs() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let o = pipeline(&[
+        "navigate",
+        "simulate",
+        "--worlds",
+        "2",
+        "--landmarks",
+        "12",
+        "--pairs",
+        "5",
+        "--images",
+        "6",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        stdout(&o).contains("10 trips over 2 fields of 12 landmarks"),
+        "{}",
+        stdout(&o)
+    );
+    for file in [
+        "trips.csv",
+        "summary.json",
+        "flowfield.png",
+        "flowfield.svg",
+    ] {
+        assert!(dir.join(file).is_file(), "{file}");
+    }
+    let csv = std::fs::read_to_string(dir.join("trips.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 11);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["summary"]["trips"], 10);
+    for bad in [
+        vec!["navigate", "simulate", "--worlds", "0"],
+        vec!["navigate", "simulate", "--step", "0.9"],
+        vec!["navigate", "simulate", "--landmarks", "2"],
+        vec!["navigate", "simulate", "--nearest", "2", "--images", "3"],
+    ] {
+        let o = pipeline(&bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).starts_with("error: "),
+            "{bad:?}"
+        );
+    }
+}
