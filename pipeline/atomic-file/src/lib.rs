@@ -3,10 +3,53 @@
 //! and renamed over it; on failure the temporary file is removed. A reader — or a batch that
 //! crashed half-way — never sees a half-written file, and concurrent writers of the same target
 //! do not trample each other's temporary files.
+//!
+//! Outputs that belong together (a run's map, records and recordings) are staged as an
+//! [`OutputSet`] and renamed in one quick pass once all are written, so that a run either
+//! replaces all of an earlier run's files or none. An interrupt handler calls [`abandon_all`]:
+//! it waits for a pass of renames under way to finish, then removes every temporary file still
+//! live, so that an interrupted process leaves the earlier outputs as they were and nothing
+//! half-written beside them.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+/// Temporary files created and neither committed nor removed yet.
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Held while an [`OutputSet`] renames its files, and by [`abandon_all`].
+static RENAMING: Mutex<()> = Mutex::new(());
+
+/// A lock that a panic elsewhere does not make unusable: the data are plain lists.
+fn lock<T>(mutex: &'static Mutex<T>) -> MutexGuard<'static, T> {
+    mutex
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Removes every live temporary file of this process, after any [`OutputSet::commit`] under
+/// way has finished; for an interrupt handler that then ends the process. Returns how many
+/// files were removed. The renaming lock stays held until the process ends, so that no set is
+/// committed half-way after this.
+pub fn abandon_all() -> usize {
+    std::mem::forget(lock(&RENAMING));
+    let live = std::mem::take(&mut *lock(&LIVE));
+    live.iter()
+        .filter(|path| std::fs::remove_file(path).is_ok())
+        .count()
+}
+
+fn register(path: &Path) {
+    lock(&LIVE).push(path.to_path_buf());
+}
+
+fn unregister(path: &Path) {
+    let mut live = lock(&LIVE);
+    if let Some(i) = live.iter().position(|p| p == path) {
+        live.swap_remove(i);
+    }
+}
 
 /// Produces `path` by letting `write` fill a temporary file (whose name keeps `path`'s
 /// extension, for encoders that choose their format by it), then renaming it. `io_error` turns
@@ -34,8 +77,10 @@ pub struct Temporary {
 impl Temporary {
     /// Names a fresh temporary file beside `target`; nothing is created yet.
     pub fn beside(target: &Path) -> Self {
+        let path = temporary_path(target);
+        register(&path);
         Self {
-            path: temporary_path(target),
+            path,
             target: target.to_path_buf(),
             committed: false,
         }
@@ -52,8 +97,17 @@ impl Temporary {
     }
 
     /// Syncs the temporary file and renames it over the target.
-    pub fn commit(mut self) -> std::io::Result<()> {
-        std::fs::File::open(&self.path)?.sync_all()?;
+    pub fn commit(self) -> std::io::Result<()> {
+        self.sync()?;
+        let _renaming = lock(&RENAMING);
+        self.rename()
+    }
+
+    fn sync(&self) -> std::io::Result<()> {
+        std::fs::File::open(&self.path)?.sync_all()
+    }
+
+    fn rename(mut self) -> std::io::Result<()> {
         std::fs::rename(&self.path, &self.target)?;
         self.committed = true;
         Ok(())
@@ -67,6 +121,71 @@ impl Drop for Temporary {
             // whatever made the output fail is the error worth reporting.
             let _ = std::fs::remove_file(&self.path);
         }
+        unregister(&self.path);
+    }
+}
+
+/// Outputs that replace an earlier set together: each is written to its temporary file as it
+/// is staged, and [`OutputSet::commit`] syncs them all, then renames them all and removes the
+/// earlier set's files this one does not replace. Dropped uncommitted, it removes its
+/// temporary files and the earlier outputs stay as they were.
+#[derive(Debug, Default)]
+pub struct OutputSet {
+    staged: Vec<Temporary>,
+    stale: Vec<PathBuf>,
+}
+
+impl OutputSet {
+    pub fn new() -> OutputSet {
+        OutputSet::default()
+    }
+
+    /// Stages `path`, written by `write` into its temporary file.
+    pub fn stage<E>(
+        &mut self,
+        path: &Path,
+        write: impl FnOnce(&Path) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let temporary = Temporary::beside(path);
+        write(temporary.path())?;
+        self.staged.push(temporary);
+        Ok(())
+    }
+
+    /// Stages `path` with content `bytes`.
+    pub fn stage_bytes(&mut self, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+        self.stage(path, |temporary| {
+            std::fs::File::create(temporary)?.write_all(bytes)
+        })
+    }
+
+    /// Adds a temporary file written elsewhere (a recording).
+    pub fn adopt(&mut self, temporary: Temporary) {
+        self.staged.push(temporary);
+    }
+
+    /// Removes `path` at commit, if it exists: an earlier output this set does not replace.
+    pub fn remove_stale(&mut self, path: &Path) {
+        self.stale.push(path.to_path_buf());
+    }
+
+    /// Syncs every staged file, then renames each over its target and removes the stale
+    /// files. An interrupt waits for the renames ([`abandon_all`]).
+    pub fn commit(self) -> std::io::Result<()> {
+        for temporary in &self.staged {
+            temporary.sync()?;
+        }
+        let _renaming = lock(&RENAMING);
+        for temporary in self.staged {
+            temporary.rename()?;
+        }
+        for path in &self.stale {
+            match std::fs::remove_file(path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
+                _ => {}
+            }
+        }
+        Ok(())
     }
 }
 
@@ -124,5 +243,43 @@ mod tests {
             .map(|e| e.unwrap().file_name().into_string().unwrap())
             .collect();
         assert_eq!(names, ["a.txt"]);
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        names
+    }
+
+    #[test]
+    fn a_set_replaces_all_or_nothing() {
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
+        for name in ["map.json", "eval.json", "notes.txt"] {
+            std::fs::write(dir.join(name), b"old").unwrap();
+        }
+        // Abandoned: the earlier files stay, no temporary is left.
+        let mut set = OutputSet::new();
+        set.stage_bytes(&dir.join("map.json"), b"new").unwrap();
+        set.stage_bytes(&dir.join("rng.json"), b"new").unwrap();
+        set.remove_stale(&dir.join("eval.json"));
+        drop(set);
+        assert_eq!(names(dir), ["eval.json", "map.json", "notes.txt"]);
+        assert_eq!(std::fs::read(dir.join("map.json")).unwrap(), b"old");
+        // Committed: every staged file replaced, the stale one gone, the rest untouched.
+        let mut set = OutputSet::new();
+        set.stage_bytes(&dir.join("map.json"), b"new").unwrap();
+        let recording = Temporary::beside(&dir.join("run.mcap"));
+        std::fs::write(recording.path(), b"new").unwrap();
+        set.adopt(recording);
+        set.remove_stale(&dir.join("eval.json"));
+        set.remove_stale(&dir.join("never-written.png"));
+        set.commit().unwrap();
+        assert_eq!(names(dir), ["map.json", "notes.txt", "run.mcap"]);
+        assert_eq!(std::fs::read(dir.join("run.mcap")).unwrap(), b"new");
+        assert_eq!(std::fs::read(dir.join("notes.txt")).unwrap(), b"old");
     }
 }

@@ -13,6 +13,7 @@ use qrm_core::geometry::{boundary_values, Point};
 use std::process::ExitCode;
 
 mod commands;
+mod interrupt;
 mod recording;
 use commands::CalculusName;
 
@@ -243,6 +244,7 @@ fn end_quietly_on_broken_pipe() {}
 
 fn main() -> ExitCode {
     end_quietly_on_broken_pipe();
+    interrupt::install();
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -535,3 +535,87 @@ fn a_bad_image_is_skipped_with_a_warning() {
     assert_eq!(summary["stations"], 4);
     assert_eq!(summary["stations_skipped"], 2);
 }
+
+/// An interrupt at any moment of a run (reading, detecting, mapping, writing, scoring) leaves
+/// the earlier run's outputs all as they were or all replaced, and no temporary file: SIGINT at
+/// a sweep of delays over the demo run, and SIGTERM once.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_run_leaves_the_earlier_outputs_whole() {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    const OUTPUTS: [&str; 8] = [
+        "map.json",
+        "rng.json",
+        "rng.png",
+        "stations.json",
+        "landmarks.json",
+        "summary.json",
+        "run.mcap",
+        "eval.json",
+    ];
+    let out = scratch("interrupted");
+    // How long an uninterrupted run takes on this machine: the sweep spans it.
+    let start = Instant::now();
+    assert!(
+        pipeline(&["run", "--images", DEMO, "--out", arg(&out), "--quiet"])
+            .status
+            .success()
+    );
+    let whole = start.elapsed();
+    let mut interrupted = 0;
+    for (k, signal) in (0..12)
+        .map(|k| (k, libc::SIGINT))
+        .chain(std::iter::once((6, libc::SIGTERM)))
+    {
+        for name in OUTPUTS {
+            std::fs::write(out.join(name), "old").unwrap();
+        }
+        let child = Command::new(env!("CARGO_BIN_EXE_pipeline"))
+            .args(["run", "--images", DEMO, "--out", arg(&out), "--quiet"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(whole.mul_f64(f64::from(k) / 10.0) + Duration::from_millis(20));
+        // SAFETY: signalling our own child, which has not been waited for yet.
+        unsafe {
+            libc::kill(child.id() as libc::pid_t, signal);
+        }
+        let o = child.wait_with_output().unwrap();
+        let names: Vec<String> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        assert!(
+            names.iter().all(|n| !n.starts_with('.')),
+            "delay {k}: temporary files left: {names:?}"
+        );
+        let old: Vec<&str> = OUTPUTS
+            .iter()
+            .copied()
+            .filter(|n| std::fs::read(out.join(n)).is_ok_and(|b| b == b"old"))
+            .collect();
+        match o.status.code() {
+            Some(130) => {
+                interrupted += 1;
+                assert!(
+                    String::from_utf8_lossy(&o.stderr).contains("no partial output left behind"),
+                    "{}",
+                    String::from_utf8_lossy(&o.stderr)
+                );
+                // Before the renames everything is old; after them (while scoring) nothing is,
+                // and the old eval.json is gone.
+                assert!(
+                    old.len() == OUTPUTS.len() || old.is_empty(),
+                    "delay {k}: mixed outputs, still old: {old:?}"
+                );
+            }
+            Some(0) => assert!(old.is_empty(), "delay {k}: {old:?}"),
+            // Signalled before the handler was installed: nothing was started.
+            None => assert_eq!(old.len(), OUTPUTS.len(), "delay {k}"),
+            other => panic!("delay {k}: status {other:?}"),
+        }
+    }
+    assert!(interrupted >= 6, "only {interrupted} runs were interrupted");
+}

@@ -1,12 +1,12 @@
 //! `pipeline run --images DIR`: panoramas in, qualitative map and RNG out (docs/RUN.md).
 
-use super::output::write_atomic;
 use super::rng_json;
 use crate::recording::{McapRecorder, Recorder, RngDrawing};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use image::RgbImage;
 use indicatif::{ProgressBar, ProgressStyle};
+use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
 use qrm_core::neighborhood::estimate;
@@ -254,15 +254,25 @@ pub fn run(args: RunArgs) -> Result<()> {
         record_station(&mut recorders, record, &mapper.map, &survey, &calib)
     })?;
 
-    write_outputs(&args.out, &traverse.mapper, &traverse.records)?;
+    // Every output is staged and then renamed in one pass: an earlier run's files are all
+    // replaced or none are (an interrupt before the pass leaves them as they were).
+    let mut outputs = OutputSet::new();
+    stage_outputs(&mut outputs, &args.out, &traverse.mapper, &traverse.records)?;
     for recorder in recorders {
-        recorder.finish()?;
+        outputs.adopt(recorder.finish()?);
     }
     let summary = traverse.summary(detected.wall_seconds);
-    write_atomic(
+    stage(
+        &mut outputs,
         &args.out.join("summary.json"),
         (serde_json::to_string_pretty(&summary)? + "\n").as_bytes(),
     )?;
+    // A scoring left from an earlier run into the same directory would not be this run's; the
+    // new one is written after the run's files are in place.
+    outputs.remove_stale(&args.out.join("eval.json"));
+    outputs
+        .commit()
+        .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
     let truth = args.truth.clone().or_else(|| {
         let default = args.images.join("truth.json");
         default.exists().then_some(default)
@@ -271,11 +281,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         (Some(truth), false) => Some(super::eval::score_run_files(
             &args.out, &truth, &calib, &args.out,
         )?),
-        // A scoring left from an earlier run into the same directory would not be this run's.
-        _ => {
-            remove_stale(&args.out.join("eval.json"))?;
-            None
-        }
+        _ => None,
     };
     // Printed once every file is written: a reader that stops early ends the process.
     print_summary(&summary, &args.out, started);
@@ -377,21 +383,28 @@ fn print_warnings(tally: &[(usize, String)], quiet: bool) {
     }
 }
 
-/// Removes an output of an earlier run into the same directory that this run does not write.
-fn remove_stale(path: &Path) -> Result<()> {
-    match std::fs::remove_file(path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(e).with_context(|| format!("cannot remove the stale {}", path.display()))
-        }
-        _ => Ok(()),
-    }
+/// Stages `bytes` as `path`.
+fn stage(outputs: &mut OutputSet, path: &Path, bytes: &[u8]) -> Result<()> {
+    outputs
+        .stage_bytes(path, bytes)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// map.json, rng.json, rng.png, stations.json, landmarks.json.
-fn write_outputs(out: &Path, mapper: &Mapper<Edc>, records: &[StationRecord]) -> Result<()> {
-    write_atomic(&out.join("map.json"), mapper.map.to_json().as_bytes())?;
+/// map.json, rng.json, rng.png, stations.json, landmarks.json, staged.
+fn stage_outputs(
+    outputs: &mut OutputSet,
+    out: &Path,
+    mapper: &Mapper<Edc>,
+    records: &[StationRecord],
+) -> Result<()> {
+    stage(
+        outputs,
+        &out.join("map.json"),
+        mapper.map.to_json().as_bytes(),
+    )?;
     let rng = estimate(&mapper.map).expect("EDC has a lune");
-    write_atomic(
+    stage(
+        outputs,
         &out.join("rng.json"),
         rng_json(&mapper.map, &rng).as_bytes(),
     )?;
@@ -412,31 +425,33 @@ fn write_outputs(out: &Path, mapper: &Mapper<Edc>, records: &[StationRecord]) ->
             .iter()
             .map(|&(a, b, cost)| (index(a), index(b), cost))
             .collect();
-        write_rng(
-            &out.join("rng.png"),
-            &RngPicture {
-                title: format!(
-                    "RNG after {} stations: {} landmarks, {} possible edges",
-                    records.len(),
-                    positions.len(),
-                    edges.len()
-                ),
-                landmarks: &positions,
-                labels: &labels,
-                metric: false,
-                edges: &edges,
-                true_edges: &[],
-                stations: &[],
-            },
-        )?;
+        let picture = RngPicture {
+            title: format!(
+                "RNG after {} stations: {} landmarks, {} possible edges",
+                records.len(),
+                positions.len(),
+                edges.len()
+            ),
+            landmarks: &positions,
+            labels: &labels,
+            metric: false,
+            edges: &edges,
+            true_edges: &[],
+            stations: &[],
+        };
+        outputs.stage(&out.join("rng.png"), |temporary| {
+            write_rng(temporary, &picture)
+        })?;
     } else {
-        remove_stale(&out.join("rng.png"))?;
+        outputs.remove_stale(&out.join("rng.png"));
     }
-    write_atomic(
+    stage(
+        outputs,
         &out.join("stations.json"),
         (serde_json::to_string(records)? + "\n").as_bytes(),
     )?;
-    write_atomic(
+    stage(
+        outputs,
         &out.join("landmarks.json"),
         (serde_json::to_string_pretty(&mapper.landmarks())? + "\n").as_bytes(),
     )?;

@@ -283,7 +283,7 @@ impl Recorder for McapRecorder {
             .map_err(|p| self.error(p))
     }
 
-    fn finish(self: Box<Self>) -> Result<(), RecordingError> {
+    fn finish(self: Box<Self>) -> Result<Temporary, RecordingError> {
         let McapRecorder {
             mut writer,
             temporary,
@@ -296,9 +296,10 @@ impl Recorder for McapRecorder {
                 .into_inner()
                 .into_inner()
                 .map_err(|e| e.into_error())?;
-            Ok(temporary.commit()?)
+            Ok(())
         };
-        complete().map_err(|problem| RecordingError { path, problem })
+        complete().map_err(|problem| RecordingError { path, problem })?;
+        Ok(temporary)
     }
 }
 

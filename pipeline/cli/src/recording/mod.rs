@@ -11,6 +11,7 @@ mod rerun_recorder;
 #[cfg(test)]
 mod tests;
 
+use qrm_atomic_file::Temporary;
 use std::path::PathBuf;
 
 use qrm_vision::run::StationRecord;
@@ -34,9 +35,10 @@ pub trait Recorder {
     ) -> Result<(), RecordingError>;
     /// After each station: the current RNG estimate drawn over a 2-D layout of the landmarks.
     fn rng(&mut self, index: usize, drawing: &RngDrawing) -> Result<(), RecordingError>;
-    /// Completes the file and moves it into place (atomic: nothing at the target until then; a
-    /// recorder dropped without finish leaves nothing behind).
-    fn finish(self: Box<Self>) -> Result<(), RecordingError>;
+    /// Completes the file, still under its temporary name: the run moves it into place with
+    /// its other outputs (`OutputSet::adopt`). A recorder dropped without finish, or a
+    /// temporary dropped uncommitted, leaves nothing behind.
+    fn finish(self: Box<Self>) -> Result<Temporary, RecordingError>;
 }
 
 /// The RNG estimate as drawn: the map has no metric positions, so the run supplies a layout.

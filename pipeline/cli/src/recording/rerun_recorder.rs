@@ -155,17 +155,13 @@ impl Recorder for RerunRecorder {
         self.log_rng(index, drawing).map_err(|e| self.error(e))
     }
 
-    fn finish(self: Box<Self>) -> Result<(), RecordingError> {
+    fn finish(self: Box<Self>) -> Result<Temporary, RecordingError> {
         self.stream.flush_blocking().map_err(|e| self.error(e))?;
         let RerunRecorder { stream, temporary } = *self;
         // Writes the footer and closes the file; dropping the stream then joins its threads.
         stream.finalize_deferred_sinks();
         drop(stream);
-        let path = temporary.target().to_path_buf();
-        temporary.commit().map_err(|e| RecordingError {
-            path,
-            problem: e.into(),
-        })
+        Ok(temporary)
     }
 }
 

@@ -160,7 +160,7 @@ fn record(mut recorder: Box<dyn Recorder>, stations: usize, panorama: &image::Rg
         recorder.station(&station(index), panorama).unwrap();
         recorder.rng(index, &drawing(index)).unwrap();
     }
-    recorder.finish().unwrap();
+    recorder.finish().unwrap().commit().unwrap();
 }
 
 /// Copies a finished recording to `$QRM_RECORDING_SAMPLES/sample.<extension>`.
