@@ -14,8 +14,8 @@ use qrm_core::map::{Hypergraph, LandmarkId};
 use qrm_core::navigation::{convex_hull, Command, LegFollower, RouteCost, RouteGraph};
 use qrm_core::neighborhood::{estimate, true_rng};
 use qrm_core::simulation::{
-    drive, nearest, Drive, Layout, NavigationStudy, NavigationSummary, RngSource, Sensor,
-    TripRecord,
+    drive, nearest, Controller, Drive, Layout, NavigationStudy, NavigationSummary, RngSource,
+    Sensor, TripRecord,
 };
 use qrm_plot::{write_flow, FlowPicture};
 use rand::SeedableRng;
@@ -70,6 +70,12 @@ pub enum LayoutName {
     Grid,
 }
 
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ControllerName {
+    Legs,
+    Flow,
+}
+
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
     /// Random landmark fields.
@@ -105,6 +111,11 @@ pub struct SimulateArgs {
     /// Step length, as a fraction of the side (seed digest A.7: 0.5 %).
     #[arg(long, default_value_t = 0.005)]
     step: f64,
+    /// `legs`: plan once and follow the route leg by leg (000 §VII-B); `flow`: memoryless, in
+    /// each cell head for the next hop of the route from that cell (000 Fig. 6), which can
+    /// cycle.
+    #[arg(long, value_enum, default_value = "legs")]
+    controller: ControllerName,
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Output directory.
@@ -252,6 +263,10 @@ fn study(args: &SimulateArgs) -> Result<NavigationStudy> {
             cost: RouteCost {
                 lambda: args.lambda,
             },
+            controller: match args.controller {
+                ControllerName::Legs => Controller::Legs,
+                ControllerName::Flow => Controller::Flow,
+            },
         },
         seed: args.seed,
     })
@@ -283,6 +298,7 @@ fn simulate(args: &SimulateArgs) -> Result<()> {
         "layout": study.layout,
         "rng": study.source,
         "lambda": study.drive.cost.lambda,
+        "controller": study.drive.controller,
         "step": study.drive.step,
         "visible": args.visible,
         "seed": study.seed,
@@ -338,13 +354,17 @@ fn summary_text(study: &NavigationStudy, s: &NavigationSummary, seconds: f64) ->
     };
     let outcomes: Vec<String> = s.outcomes.iter().map(|(k, v)| format!("{k} {v}")).collect();
     format!(
-        "{} trips over {} fields of {} landmarks, planning on {source} (λ = {}):\n  \
+        "{} trips over {} fields of {} landmarks, planning on {source} (λ = {}), {}:\n  \
          success {:.1} %  ({})\n  path length / straight distance: median {:.3}, 90th percentile {:.3}\n  \
          mean legs {:.2}, mean re-plans {:.2}; {:.1} s\n",
         s.trips,
         study.worlds,
         study.landmarks,
         study.drive.cost.lambda,
+        match study.drive.controller {
+            Controller::Legs => "following legs",
+            Controller::Flow => "memoryless (flow field)",
+        },
         100.0 * s.success_rate,
         outcomes.join(", "),
         s.median_length_ratio,

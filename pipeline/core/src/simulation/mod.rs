@@ -11,7 +11,7 @@ mod sensor;
 
 pub use mapping::{run, Step};
 pub use montecarlo::{MonteCarlo, MonteCarloResult, Series, Statistic};
-pub use navigation::{drive, nearest, Drive, Leg, Outcome, Trip};
+pub use navigation::{drive, nearest, Controller, Drive, Leg, Outcome, Trip};
 pub use navigation_study::{
     jittered_grid, Layout, NavigationStudy, NavigationSummary, RngSource, TripRecord,
 };

@@ -23,7 +23,23 @@ pub struct Drive {
     pub max_replans: usize,
     pub sensor: Sensor,
     pub cost: RouteCost,
+    pub controller: Controller,
 }
+
+/// How the rover picks its heading (seed digest A.6, item 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Controller {
+    /// 000 §VII-B's steps: plan once, then follow the route leg by leg ([`LegFollower`]).
+    Legs,
+    /// Memoryless, as 000 Fig. 6 draws it: in whichever cell the rover is, head for the next
+    /// hop of the cheapest route from that cell's landmark to the goal's. Driving toward the
+    /// next hop can cross a third cell no closer in hops, so this one can cycle.
+    Flow,
+}
+
+/// Entries into one cell after which a memoryless trip counts as cycling.
+const CYCLE_ENTRIES: usize = 3;
 
 /// How a trip ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -39,6 +55,8 @@ pub enum Outcome {
     TargetLost,
     /// The step budget ran out.
     OutOfSteps,
+    /// The memoryless controller entered one cell [`CYCLE_ENTRIES`] times.
+    Cycled,
 }
 
 /// One simulated trip.
@@ -115,8 +133,23 @@ pub fn drive(
     let mut follower = LegFollower::new(&route);
     let mut here = start;
     let mut lost = Vec::new();
+    let mut entered: Vec<LandmarkId> = Vec::new();
     while trip.steps() < drive.max_steps {
         let (visible, view) = drive.sensor.observe(world, here, rng);
+        if drive.controller == Controller::Flow {
+            if let Some(Cell::Certain(cell)) = cell_of(&visible, &view.order) {
+                if entered.last() != Some(&cell) {
+                    entered.push(cell);
+                    if entered.iter().filter(|&&c| c == cell).count() >= CYCLE_ENTRIES {
+                        trip.outcome = Outcome::Cycled;
+                        return trip;
+                    }
+                }
+                if let Ok(route) = graph.plan(cell, goal_landmark, drive.cost) {
+                    follower = LegFollower::new(&route);
+                }
+            }
+        }
         match follower.step(&visible, &view) {
             Command::Toward { landmark, bearing } => {
                 match trip.legs.last_mut() {
@@ -203,6 +236,7 @@ mod tests {
             max_replans: 3,
             sensor: Sensor::exact(None),
             cost: RouteCost::default(),
+            controller: Controller::Legs,
         }
     }
 
@@ -231,6 +265,31 @@ mod tests {
                 // landmarks between).
                 let mut ahead = trip.route[1..].iter();
                 assert!(trip.legs.iter().all(|leg| ahead.any(|&l| l == leg.target)));
+            }
+        }
+    }
+
+    /// The memoryless controller of 000 Fig. 6 either arrives or is caught cycling; it never
+    /// wanders until the step budget runs out.
+    #[test]
+    fn a_memoryless_trip_arrives_or_is_caught_cycling() {
+        let flow = Drive {
+            controller: Controller::Flow,
+            ..ideal()
+        };
+        for world in 0..3u64 {
+            let points = Scenario::random(world, 30, 0, 100.0).landmarks;
+            let graph = true_graph(&points);
+            let mut rng = ChaCha8Rng::seed_from_u64(world);
+            for _ in 0..20 {
+                let mut point =
+                    || Point::new(rng.random_range(0.0..100.0), rng.random_range(0.0..100.0));
+                let (start, goal) = (point(), point());
+                let trip = drive(&points, &graph, start, goal, &flow, &mut rng);
+                assert!(
+                    matches!(trip.outcome, Outcome::Arrived | Outcome::Cycled),
+                    "{trip:?}"
+                );
             }
         }
     }

@@ -231,6 +231,7 @@ impl NavigationSummary {
 mod tests {
     use super::*;
     use crate::navigation::RouteCost;
+    use crate::simulation::Controller;
 
     fn study(source: RngSource) -> NavigationStudy {
         NavigationStudy {
@@ -246,6 +247,7 @@ mod tests {
                 max_replans: 3,
                 sensor: Sensor::exact(None),
                 cost: RouteCost::default(),
+                controller: Controller::Legs,
             },
             seed: 5,
         }
