@@ -306,3 +306,41 @@ fn synthesises_a_stress_member() {
     assert_eq!(truth["variant"]["jpeg_quality"], 85);
     assert!(dir.join("station_000.jpg").is_file());
 }
+
+#[test]
+fn closes_and_checks_constraint_networks() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    std::fs::write(
+        dir.join("net.txt"),
+        "# four landmarks\n0 1 2 {1}\n0 1 3 {5,6}\n1 2 3 3,4,9\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("bad.txt"), "0 1 2 {1}\n0 1 3 {5,6}\n1 2 0 {2}\n").unwrap();
+    let o = pipeline(&["map", "check", &path("net.txt")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(stdout(&o).contains("consistent") && stdout(&o).contains("closing tightens 2"));
+    let o = pipeline(&["map", "close", &path("net.txt"), "--out", &path("net.json")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The closed map is a map: `map info` reads it.
+    assert!(pipeline(&["map", "info", &path("net.json")])
+        .status
+        .success());
+    let o = pipeline(&["map", "check", &path("bad.txt")]);
+    assert_eq!(o.status.code(), Some(1));
+    let text = stdout(&o);
+    assert!(
+        text.contains("minimal set of 2 conflicting constraints"),
+        "{text}"
+    );
+    assert!(text.contains("0 1 2 {1}") && text.contains("1 2 0 {2}") && !text.contains("0 1 3"));
+    let o = pipeline(&["map", "close", &path("bad.txt"), "--out", &path("bad.json")]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("nothing was written"));
+    assert!(!dir.join("bad.json").exists());
+    std::fs::write(dir.join("typo.txt"), "0 1 2 {1}\n0 1 x {2}\n").unwrap();
+    let o = pipeline(&["map", "check", &path("typo.txt"), "--calculus", "fdc"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("line 2"));
+}

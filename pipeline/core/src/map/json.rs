@@ -104,72 +104,17 @@ impl<C: Calculus> Hypergraph<C> {
     /// possible between distinct landmarks (`C::universe()`), no empty relation; finally that
     /// the map is closed: the unary operators and the path-consistency closure change nothing.
     pub fn from_json(text: &str) -> Result<Hypergraph<C>, MapFormatError> {
-        let file: MapFile = serde_json::from_str(text)?;
-        if file.format != FORMAT {
-            return Err(MapFormatError::Format(file.format));
-        }
-        if file.version != VERSION {
-            return Err(MapFormatError::Version(file.version));
-        }
-        if file.calculus != C::NAME {
-            return Err(MapFormatError::Calculus {
-                expected: C::NAME,
-                found: file.calculus,
-            });
-        }
-        if file.landmarks.len() > MAX_LANDMARKS {
-            return Err(MapFormatError::TooManyLandmarks(file.landmarks.len()));
-        }
+        let (landmarks, entries) = parse_entries::<C>(text)?;
         let mut map = Hypergraph::<C>::new();
-        for &id in &file.landmarks {
-            if map.contains(id) {
-                return Err(MapFormatError::DuplicateLandmark(id));
-            }
+        for &id in &landmarks {
             map.push_landmark(id);
         }
         let kernel = Kernel::of::<C>();
-        let universe = C::universe();
-        let mut seen = HashSet::new();
-        for entry in &file.triples {
-            let ids = entry.ids;
-            let bad = |reason: String| MapFormatError::Triple { ids, reason };
-            let mut internal = [0usize; 3];
-            for (x, id) in internal.iter_mut().zip(ids) {
-                *x = *map
-                    .index
-                    .get(&id)
-                    .ok_or_else(|| bad(format!("landmark {id} is not in \"landmarks\"")))?;
-            }
-            let [a, b, c] = internal;
-            if a == b || b == c || a == c {
-                return Err(bad("landmark ids are not distinct".into()));
-            }
+        for (ids, relations) in entries {
+            let [a, b, c] = ids.map(|id| map.index[&id]);
             let rank = locate(a, b, c).rank;
-            if !seen.insert(rank) {
-                return Err(bad("a second entry for the same three landmarks".into()));
-            }
             let mut stored = map.edges[rank];
-            let relations = [
-                ([a, b, c], &entry.ab_c, "ab_c"),
-                ([b, c, a], &entry.bc_a, "bc_a"),
-                ([c, a, b], &entry.ca_b, "ca_b"),
-            ];
-            for ([x, y, z], numbers, name) in relations {
-                let mut set = RelationSet::EMPTY;
-                for &r in numbers {
-                    match u8::try_from(r) {
-                        Ok(r) if universe.contains(r) => set = set.with(r),
-                        _ => {
-                            return Err(bad(format!(
-                                "{name}: relation {r} is not possible between distinct landmarks in {} (possible: {universe})",
-                                C::NAME
-                            )))
-                        }
-                    }
-                }
-                if set.is_empty() {
-                    return Err(bad(format!("{name} is empty")));
-                }
+            for ([x, y, z], set) in [[a, b, c], [b, c, a], [c, a, b]].into_iter().zip(relations) {
                 let loc = locate(x, y, z);
                 stored[loc.slot] &= if loc.inverted {
                     kernel.inverse(set.bits())
@@ -229,4 +174,76 @@ impl<C: Calculus> Hypergraph<C> {
             )),
         }
     }
+}
+
+/// A map file's landmarks and its triples' relations `[AB:C, BC:A, CA:B]` for `ids = [a, b, c]`,
+/// validated as [`Hypergraph::from_json`] describes, closure aside.
+pub(super) type Entries = (Vec<LandmarkId>, Vec<([LandmarkId; 3], [RelationSet; 3])>);
+
+pub(super) fn parse_entries<C: Calculus>(text: &str) -> Result<Entries, MapFormatError> {
+    let file: MapFile = serde_json::from_str(text)?;
+    if file.format != FORMAT {
+        return Err(MapFormatError::Format(file.format));
+    }
+    if file.version != VERSION {
+        return Err(MapFormatError::Version(file.version));
+    }
+    if file.calculus != C::NAME {
+        return Err(MapFormatError::Calculus {
+            expected: C::NAME,
+            found: file.calculus,
+        });
+    }
+    if file.landmarks.len() > MAX_LANDMARKS {
+        return Err(MapFormatError::TooManyLandmarks(file.landmarks.len()));
+    }
+    let mut known = HashSet::new();
+    for &id in &file.landmarks {
+        if !known.insert(id) {
+            return Err(MapFormatError::DuplicateLandmark(id));
+        }
+    }
+    let universe = C::universe();
+    let mut seen = HashSet::new();
+    let mut entries = Vec::with_capacity(file.triples.len());
+    for entry in &file.triples {
+        let ids = entry.ids;
+        let bad = |reason: String| MapFormatError::Triple { ids, reason };
+        if let Some(id) = ids.iter().find(|id| !known.contains(id)) {
+            return Err(bad(format!("landmark {id} is not in \"landmarks\"")));
+        }
+        let [a, b, c] = ids;
+        if a == b || b == c || a == c {
+            return Err(bad("landmark ids are not distinct".into()));
+        }
+        let mut sorted = ids;
+        sorted.sort_unstable();
+        if !seen.insert(sorted) {
+            return Err(bad("a second entry for the same three landmarks".into()));
+        }
+        let mut relations = [RelationSet::EMPTY; 3];
+        let named = [
+            (&entry.ab_c, "ab_c"),
+            (&entry.bc_a, "bc_a"),
+            (&entry.ca_b, "ca_b"),
+        ];
+        for (set, (numbers, name)) in relations.iter_mut().zip(named) {
+            for &r in numbers {
+                match u8::try_from(r) {
+                    Ok(r) if universe.contains(r) => *set = set.with(r),
+                    _ => {
+                        return Err(bad(format!(
+                            "{name}: relation {r} is not possible between distinct landmarks in {} (possible: {universe})",
+                            C::NAME
+                        )))
+                    }
+                }
+            }
+            if set.is_empty() {
+                return Err(bad(format!("{name} is empty")));
+            }
+        }
+        entries.push((ids, relations));
+    }
+    Ok((file.landmarks, entries))
 }

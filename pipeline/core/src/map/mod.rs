@@ -7,6 +7,7 @@
 //! - [`Hypergraph::observations`]: the measured triples of a panorama's [`Sighting`]s as
 //!   observations, measured against what the map still allows (000 §IV, §VI-B);
 //! - [`Hypergraph::merge`]: fusing another map over the same landmark ids;
+//! - [`Network`]: constraint networks from outside, closed or narrowed to a minimal conflict;
 //! - JSON files (`docs/MAP_FORMAT.md`).
 
 mod closure;
@@ -14,6 +15,7 @@ mod hypergraph;
 mod index;
 mod json;
 mod kernel;
+mod network;
 mod observe;
 mod quad;
 mod transaction;
@@ -21,6 +23,7 @@ mod update;
 
 pub use hypergraph::{Hypergraph, Triples};
 pub use json::{MapFormatError, MAX_LANDMARKS};
+pub use network::{Network, NetworkTextError};
 pub use observe::Sighting;
 pub use update::{Contradiction, ContradictionStage, LandmarkId, Observation, UpdateReport};
 
