@@ -72,6 +72,22 @@ pub fn estimate<C: Calculus>(map: &Hypergraph<C>) -> Option<RngEstimate> {
     Some(out)
 }
 
+/// The RNG of `points` (landmark `i` at `points[i]`) as an estimate whose every edge is
+/// certain: what a converged map's estimate would be.
+pub fn true_estimate(points: &[Point]) -> RngEstimate {
+    RngEstimate {
+        edges: true_rng(points)
+            .into_iter()
+            .map(|(a, b)| RngEdge {
+                a: a as LandmarkId,
+                b: b as LandmarkId,
+                cost: 0.0,
+            })
+            .collect(),
+        pruned: 0,
+    }
+}
+
 /// The RNG of points: `i`–`j` unless some `k` is nearer to both than they are to each other.
 pub fn true_rng(points: &[Point]) -> Vec<(usize, usize)> {
     let n = points.len();

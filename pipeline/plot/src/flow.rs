@@ -142,24 +142,11 @@ impl FlowPicture {
                 label: "Voronoi cell border".into(),
             },
         ];
-        if self.edges.iter().any(|e| e.2 == 0.0) {
-            entries.push(Entry {
-                key: Key::Line(RGBColor(0, 0, 0)),
-                label: "certain RNG edge (w = 0)".into(),
-            });
-        }
-        if self.edges.iter().any(|e| e.2 > 0.0) {
-            entries.push(Entry {
-                key: Key::CostScale,
-                label: "uncertain RNG edge, cost w from 0 (blue) to 1 (red)".into(),
-            });
-        }
-        if !self.true_edges.is_empty() {
-            entries.push(Entry {
-                key: Key::Dashed(TRUE_EDGE),
-                label: "true RNG edge".into(),
-            });
-        }
+        entries.extend(legend::edge_entries(
+            &self.edges,
+            !self.true_edges.is_empty(),
+            TRUE_EDGE,
+        ));
         entries.push(Entry {
             key: Key::Line(ARROW),
             label: "direction of motion".into(),

@@ -33,6 +33,36 @@ pub(super) enum Key {
     CostScale,
 }
 
+/// The entries for RNG edges `(i, j, w)` as drawn: certain ones (`w = 0`) black, uncertain ones
+/// on the cost scale, and the true RNG dashed in `true_colour` if it is drawn; only what is drawn
+/// is listed.
+pub(super) fn edge_entries(
+    edges: &[(usize, usize, f64)],
+    true_edges: bool,
+    true_colour: RGBColor,
+) -> Vec<Entry> {
+    let mut entries = Vec::new();
+    if edges.iter().any(|e| e.2 == 0.0) {
+        entries.push(Entry {
+            key: Key::Line(RGBColor(0, 0, 0)),
+            label: "certain RNG edge (w = 0)".into(),
+        });
+    }
+    if edges.iter().any(|e| e.2 > 0.0) {
+        entries.push(Entry {
+            key: Key::CostScale,
+            label: "uncertain edge, cost w from 0 (blue) to 1 (red)".into(),
+        });
+    }
+    if true_edges {
+        entries.push(Entry {
+            key: Key::Dashed(true_colour),
+            label: "true RNG edge".into(),
+        });
+    }
+    entries
+}
+
 /// One legend entry: a swatch and its label.
 pub(super) struct Entry {
     pub key: Key,

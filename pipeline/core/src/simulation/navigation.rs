@@ -209,24 +209,14 @@ pub fn nearest(world: &[Point], p: Point) -> LandmarkId {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::neighborhood::{true_rng, RngEdge, RngEstimate};
+    use crate::neighborhood::{true_estimate, RngEdge, RngEstimate};
     use crate::simulation::Scenario;
     use rand::{Rng, SeedableRng};
 
-    /// The true RNG of `points` as an estimate with every edge certain.
+    /// The true RNG of `points`, every edge certain.
     fn true_graph(points: &[Point]) -> RouteGraph {
-        let rng = RngEstimate {
-            edges: true_rng(points)
-                .into_iter()
-                .map(|(a, b)| RngEdge {
-                    a: a as LandmarkId,
-                    b: b as LandmarkId,
-                    cost: 0.0,
-                })
-                .collect(),
-            pruned: 0,
-        };
-        RouteGraph::new(&(0..points.len() as LandmarkId).collect::<Vec<_>>(), &rng)
+        let ids: Vec<LandmarkId> = (0..points.len() as LandmarkId).collect();
+        RouteGraph::new(&ids, &true_estimate(points))
     }
 
     fn ideal() -> Drive {

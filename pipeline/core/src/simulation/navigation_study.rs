@@ -10,7 +10,7 @@ use crate::edc::Edc;
 use crate::geometry::Point;
 use crate::map::LandmarkId;
 use crate::navigation::RouteGraph;
-use crate::neighborhood::{estimate, true_rng, RngEdge, RngEstimate};
+use crate::neighborhood::{estimate, true_estimate};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -88,17 +88,7 @@ impl NavigationStudy {
     pub fn graph(&self, w: usize, points: &[Point]) -> RouteGraph {
         let ids: Vec<LandmarkId> = (0..points.len() as LandmarkId).collect();
         let rng = match self.source {
-            RngSource::True => RngEstimate {
-                edges: true_rng(points)
-                    .into_iter()
-                    .map(|(a, b)| RngEdge {
-                        a: a as LandmarkId,
-                        b: b as LandmarkId,
-                        cost: 0.0,
-                    })
-                    .collect(),
-                pruned: 0,
-            },
+            RngSource::True => true_estimate(points),
             RngSource::Mapped { images, nearest } => {
                 let mut field = Scenario::random(self.seed ^ w as u64, 0, images, self.side);
                 field.landmarks = points.to_vec();
