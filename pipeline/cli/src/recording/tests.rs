@@ -12,7 +12,7 @@ use serde_json::Value;
 use super::*;
 use qrm_vision::detection::Channels;
 use qrm_vision::run::{
-    Association, DetectionRecord, FusionRecord, MetricsRecord, RangeRecord, StageSeconds,
+    Association, DetectionRecord, Exclusion, FusionRecord, MetricsRecord, RangeRecord, StageSeconds,
 };
 
 const STATIONS: usize = 16;
@@ -62,7 +62,10 @@ fn station(index: usize) -> StationRecord {
                     2 => Association::HeldBack {
                         candidates: vec![3, 5],
                     },
-                    _ => Association::default(),
+                    3 => Association::default(),
+                    _ => Association::Unused {
+                        reason: Some(Exclusion::Touching),
+                    },
                 },
             }
         })
