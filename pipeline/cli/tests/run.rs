@@ -544,10 +544,11 @@ fn a_bad_image_is_skipped_with_a_warning() {
 fn an_interrupted_run_leaves_the_earlier_outputs_whole() {
     use std::process::{Command, Stdio};
     use std::time::{Duration, Instant};
-    const OUTPUTS: [&str; 8] = [
+    const OUTPUTS: [&str; 9] = [
         "map.json",
         "rng.json",
         "rng.png",
+        "timing.png",
         "stations.json",
         "landmarks.json",
         "summary.json",

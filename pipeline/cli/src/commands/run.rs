@@ -10,7 +10,7 @@ use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
 use qrm_core::neighborhood::estimate;
-use qrm_plot::{spring_layout, write_rng, RngPicture};
+use qrm_plot::{spring_layout, write_panels, write_rng, Curve, Panel, RngPicture};
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::Channels;
 use qrm_vision::run::{
@@ -445,6 +445,11 @@ fn stage_outputs(
     } else {
         outputs.remove_stale(&out.join("rng.png"));
     }
+    if !records.is_empty() {
+        outputs.stage(&out.join("timing.png"), |temporary| {
+            write_panels(temporary, "station", &timing_panels(records))
+        })?;
+    }
     stage(
         outputs,
         &out.join("stations.json"),
@@ -456,4 +461,34 @@ fn stage_outputs(
         (serde_json::to_string_pretty(&mapper.landmarks())? + "\n").as_bytes(),
     )?;
     Ok(())
+}
+
+/// timing.png: where each station's time went, and how the map grew, along the traverse (a long
+/// drive's cost per station should stay flat, not grow with the map).
+fn timing_panels(records: &[StationRecord]) -> Vec<Panel> {
+    let curve = |label: &str, value: &dyn Fn(&StationRecord) -> f64| Curve {
+        label: label.to_string(),
+        mean: records.iter().map(value).collect(),
+        std: Vec::new(),
+    };
+    vec![
+        Panel {
+            title: "(a) time per station by stage".into(),
+            y_label: "seconds".into(),
+            curves: vec![
+                curve("decode + detect (CPU, in parallel across stations)", &|r| {
+                    r.seconds.decode + r.seconds.detect
+                }),
+                curve("associate", &|r| r.seconds.associate),
+                curve("measure and fuse", &|r| r.seconds.map),
+            ],
+        },
+        Panel {
+            title: "(b) map size".into(),
+            y_label: "landmarks".into(),
+            curves: vec![curve("landmarks in the map", &|r| {
+                r.metrics.landmarks as f64
+            })],
+        },
+    ]
 }
