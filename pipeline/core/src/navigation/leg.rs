@@ -25,7 +25,6 @@ pub struct LegFollower {
     route: Vec<LandmarkId>,
     /// Index into `route` of the current target.
     next: usize,
-    legs_done: usize,
 }
 
 impl LegFollower {
@@ -33,13 +32,7 @@ impl LegFollower {
         LegFollower {
             route: route.landmarks.clone(),
             next: 0,
-            legs_done: 0,
         }
-    }
-
-    /// Landmarks reached so far (the start's own cell counts once entered).
-    pub fn legs_done(&self) -> usize {
-        self.legs_done
     }
 
     /// The command for a panorama showing landmarks `visible` (by view position) as `view`.
@@ -48,13 +41,11 @@ impl LegFollower {
         let cell = cell_of(visible, &view.order);
         while self.next < self.route.len() && cell == Some(Cell::Certain(self.route[self.next])) {
             self.next += 1;
-            self.legs_done += 1;
         }
         // Entering a later landmark's cell directly (a leg cut short) skips the ones before.
         if let Some(Cell::Certain(here)) = cell {
             if let Some(ahead) = self.route[self.next..].iter().position(|&l| l == here) {
                 self.next += ahead + 1;
-                self.legs_done += ahead + 1;
             }
         }
         let Some(&target) = self.route.get(self.next) else {
@@ -114,7 +105,6 @@ mod tests {
         );
         let done = view(&[2.5, 0.3], &[0, 1]);
         assert_eq!(follower.step(&[9, 8], &done), Command::Arrived);
-        assert_eq!(follower.legs_done(), 3);
     }
 
     #[test]
