@@ -9,6 +9,7 @@
 use crate::calculus::Calculus;
 use crate::geometry::Point;
 use crate::map::{Hypergraph, LandmarkId};
+use rayon::prelude::*;
 
 /// A candidate RNG edge that survived pruning.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,28 +47,37 @@ pub fn estimate<C: Calculus>(map: &Hypergraph<C>) -> Option<RngEstimate> {
     let lune = C::lune()?;
     let ids = map.landmarks();
     let n = ids.len();
-    let mut out = RngEstimate::default();
-    for (x, &a) in ids.iter().enumerate() {
-        'pair: for &b in &ids[x + 1..] {
-            let mut cost = 0.0;
-            for &c in ids {
-                if c == a || c == b {
-                    continue;
+    // Pairs are independent: each row of pairs (x, y > x) in parallel, by position in the map
+    // (no id lookups), rows in order.
+    let rows: Vec<(Vec<RngEdge>, usize)> = (0..n)
+        .into_par_iter()
+        .map(|x| {
+            let mut edges = Vec::new();
+            let mut pruned = 0;
+            'pair: for y in x + 1..n {
+                let mut cost = 0.0;
+                for z in (0..n).filter(|&z| z != x && z != y) {
+                    let open = map.relation_at(x, y, z);
+                    let conflicts = open.intersection(lune).len();
+                    if conflicts == open.len() {
+                        pruned += 1;
+                        continue 'pair;
+                    }
+                    cost += conflicts as f64 / open.len() as f64;
                 }
-                let open = map.relation(a, b, c).expect("landmarks of the map");
-                let conflicts = open.intersection(lune).len();
-                if conflicts == open.len() {
-                    out.pruned += 1;
-                    continue 'pair;
-                }
-                cost += conflicts as f64 / open.len() as f64;
+                edges.push(RngEdge {
+                    a: ids[x],
+                    b: ids[y],
+                    cost: cost / n as f64,
+                });
             }
-            out.edges.push(RngEdge {
-                a,
-                b,
-                cost: cost / n as f64,
-            });
-        }
+            (edges, pruned)
+        })
+        .collect();
+    let mut out = RngEstimate::default();
+    for (edges, pruned) in rows {
+        out.edges.extend(edges);
+        out.pruned += pruned;
     }
     Some(out)
 }

@@ -3,6 +3,8 @@
 //! - median time of one 4-unknown decision (a deterministic sample of composition triples),
 //! - wall time to regenerate each table;
 //! - with `--closure`: path-consistency closure of complete random maps (000 §VI-B);
+//! - with `--rng`: the RNG estimate (000 Algorithm 2) of maps of N landmarks, as a run makes
+//!   after every station;
 //! - with `--render`: synthetic panoramas (issue 4), one stereo pair and a 50-station set.
 
 use clap::Parser;
@@ -43,6 +45,10 @@ struct Args {
     /// Fuse each closure network this many times into a fresh map; prints min and median.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     repeat: u32,
+    /// Time the RNG estimate (Algorithm 2) of a map of N landmarks that knows nothing (every
+    /// pair an edge, every third landmark examined: the slowest case) (repeatable).
+    #[arg(long, num_args = 1.., value_name = "N")]
+    rng: Vec<usize>,
     /// Time the synthetic renderer instead (30 rocks, `calib/default.toml`).
     #[arg(long)]
     render: bool,
@@ -354,6 +360,27 @@ fn time_decisions(problems: &[(Vec<f64>, Vec<f64>, Vec<Quadratic>)]) -> (f64, f6
     (times[times.len() / 2], times[times.len() * 9 / 10], counts)
 }
 
+/// Times `neighborhood::estimate` on a map of `n` unrelated landmarks (the median of 5).
+fn bench_rng(n: usize) {
+    let mut map = Hypergraph::<Edc>::new();
+    map.add_landmarks(&(0..n as u32).collect::<Vec<_>>());
+    let mut times: Vec<f64> = (0..5)
+        .map(|_| {
+            let start = Instant::now();
+            let rng = qrm_core::neighborhood::estimate(&map).expect("EDC has a lune");
+            assert_eq!(rng.edges.len(), n * (n - 1) / 2);
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    println!(
+        "RNG estimate, {n} landmarks: median {:.1} ms ({} pairs × {} third landmarks)",
+        times[2],
+        n * (n - 1) / 2,
+        n - 2
+    );
+}
+
 fn main() {
     let args = Args::parse();
     if let Some(dir) = &args.detect {
@@ -370,6 +397,12 @@ fn main() {
     if !args.measure.is_empty() {
         for &n in &args.measure {
             bench_measure(n, args.uncertainty);
+        }
+        return;
+    }
+    if !args.rng.is_empty() {
+        for &n in &args.rng {
+            bench_rng(n);
         }
         return;
     }

@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
-use qrm_core::neighborhood::estimate;
+use qrm_core::neighborhood::RngEstimate;
 use qrm_plot::{spring_layout, write_panels, write_rng, Curve, Panel, RngPicture};
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::Channels;
@@ -82,10 +82,9 @@ fn recorders(args: &RunArgs) -> Result<Vec<Box<dyn Recorder>>> {
     Ok(vec![mcap])
 }
 
-/// The RNG estimate of the map over a graph layout, for the recorders and rng.png.
-fn rng_drawing(map: &Hypergraph<Edc>) -> RngDrawing {
+/// The map's RNG estimate `rng` over a graph layout, for the recorders and rng.png.
+fn rng_drawing(map: &Hypergraph<Edc>, rng: &RngEstimate) -> RngDrawing {
     let ids = map.landmarks();
-    let rng = estimate(map).unwrap_or_default();
     let index = |id: u32| ids.iter().position(|&l| l == id).expect("edge of the map");
     let layout = spring_layout(
         ids.len(),
@@ -251,7 +250,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     let mut recorders = recorders(&args)?;
     let mapper: Mapper<Edc> = Mapper::new(calib, settings.sensor, settings.association);
     let traverse = map_stations(&detected, mapper, &bars, |record, mapper| {
-        record_station(&mut recorders, record, &mapper.map, &survey, &calib)
+        record_station(&mut recorders, record, mapper, &survey, &calib)
     })?;
 
     // Every output is staged and then renamed in one pass: an earlier run's files are all
@@ -319,7 +318,7 @@ fn load_calibration(args: &RunArgs) -> Result<Calibration> {
 fn record_station(
     recorders: &mut [Box<dyn Recorder>],
     record: &StationRecord,
-    map: &Hypergraph<Edc>,
+    mapper: &Mapper<Edc>,
     survey: &Survey,
     calib: &Calibration,
 ) -> Result<()> {
@@ -330,7 +329,7 @@ fn record_station(
     } else {
         no_image.clone()
     };
-    let drawing = rng_drawing(map);
+    let drawing = rng_drawing(&mapper.map, mapper.rng());
     for recorder in recorders.iter_mut() {
         let image = if recorder.wants_panorama() {
             &panorama
@@ -402,13 +401,12 @@ fn stage_outputs(
         &out.join("map.json"),
         mapper.map.to_json().as_bytes(),
     )?;
-    let rng = estimate(&mapper.map).expect("EDC has a lune");
     stage(
         outputs,
         &out.join("rng.json"),
-        rng_json(&mapper.map, &rng).as_bytes(),
+        rng_json(&mapper.map, mapper.rng()).as_bytes(),
     )?;
-    let drawing = rng_drawing(&mapper.map);
+    let drawing = rng_drawing(&mapper.map, mapper.rng());
     if !drawing.landmarks.is_empty() {
         let index = |id: u32| {
             drawing

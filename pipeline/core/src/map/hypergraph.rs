@@ -91,13 +91,20 @@ impl<C: Calculus> Hypergraph<C> {
         if ia == ib || ib == ic || ia == ic {
             return None;
         }
+        Some(self.relation_at(ia, ib, ic))
+    }
+
+    /// [`Hypergraph::relation`] for landmarks at positions `ia`, `ib`, `ic` of
+    /// [`Hypergraph::landmarks`] (distinct, in range): no id lookup, for queries over every
+    /// triple (the RNG estimate after every station).
+    pub fn relation_at(&self, ia: usize, ib: usize, ic: usize) -> RelationSet {
         let loc = locate(ia, ib, ic);
         let stored = self.edges[loc.rank][loc.slot];
-        Some(RelationSet::from_bits(if loc.inverted {
+        RelationSet::from_bits(if loc.inverted {
             Kernel::of::<C>().inverse(stored)
         } else {
             stored
-        }))
+        })
     }
 
     /// Every edge once, in storage order, as landmark ids `(a, b, c)` (insertion order

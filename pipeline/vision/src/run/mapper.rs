@@ -13,7 +13,7 @@ use crate::ranging::{self, PrimaryEye, Ranged, SensorModel};
 use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
 use qrm_core::measurement::StationView;
-use qrm_core::neighborhood::estimate;
+use qrm_core::neighborhood::{estimate, RngEstimate};
 use std::time::Instant;
 
 /// One station's detections, ready for mapping.
@@ -73,6 +73,8 @@ pub struct Mapper<C: Calculus> {
     next_landmark: LandmarkId,
     /// `(station, detection) → landmark` for every fused detection, for evaluation.
     pub sightings: Vec<(usize, usize, LandmarkId)>,
+    /// The RNG estimate after the latest station.
+    rng: RngEstimate,
 }
 
 impl<C: Calculus> Mapper<C> {
@@ -89,6 +91,7 @@ impl<C: Calculus> Mapper<C> {
             expired: 0,
             next_landmark: 0,
             sightings: Vec::new(),
+            rng: RngEstimate::default(),
         }
     }
 
@@ -156,7 +159,7 @@ impl<C: Calculus> Mapper<C> {
                 usable.len()
             ));
             record.fusion.resolved_held_back = self.retry_held_back(&mut record);
-            record.metrics = self.metrics();
+            record.metrics = self.refresh_metrics();
             return record;
         }
 
@@ -196,7 +199,7 @@ impl<C: Calculus> Mapper<C> {
         self.fuse_station(&mut record, associated, view);
         record.fusion.resolved_held_back = self.retry_held_back(&mut record);
         record.seconds.map = start.elapsed().as_secs_f64();
-        record.metrics = self.metrics();
+        record.metrics = self.refresh_metrics();
         record
     }
 
@@ -394,21 +397,27 @@ impl<C: Calculus> Mapper<C> {
         resolved
     }
 
-    /// The map's state after a station.
-    pub fn metrics(&self) -> MetricsRecord {
+    /// The RNG estimate of the map after the latest station.
+    pub fn rng(&self) -> &RngEstimate {
+        &self.rng
+    }
+
+    /// The map's state after a station; the RNG estimate is computed once here and kept for
+    /// [`Mapper::rng`] (on a long drive it is the costliest per-station query: every pair of
+    /// landmarks against every third).
+    fn refresh_metrics(&mut self) -> MetricsRecord {
         let triples = self.map.triple_count();
         let states = 3 * triples * C::universe().len();
-        let rng = estimate(&self.map);
+        self.rng = estimate(&self.map).unwrap_or_default();
+        let rng = &self.rng;
         MetricsRecord {
             landmarks: self.map.len(),
             triples,
             open_fraction: ratio(self.map.open_states(), states),
             fully_constrained_fraction: ratio(self.map.fully_constrained_triples(), triples),
-            rng_certain: rng.as_ref().map_or(0, |r| r.certain().count()),
-            rng_uncertain: rng
-                .as_ref()
-                .map_or(0, |r| r.edges.len() - r.certain().count()),
-            rng_cost: rng.as_ref().map_or(0.0, |r| r.total_cost()),
+            rng_certain: rng.certain().count(),
+            rng_uncertain: rng.edges.len() - rng.certain().count(),
+            rng_cost: rng.total_cost(),
         }
     }
 }
