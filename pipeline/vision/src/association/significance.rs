@@ -2,27 +2,27 @@
 //! matching (Moisan & Stival 2004, "A probabilistic criterion to detect rigid point matches
 //! between two images and estimate the fundamental matrix", ORSA).
 //!
-//! The null model drops each of the current station's detections anywhere in the frame's area,
-//! independently. A motion hypothesised from two seed correspondences that also brings `j − 2`
-//! more detections within `r` of a frame landmark would do so by chance with probability at
-//! most the binomial tail of `j − 2` hits among the other detections, each with probability
-//! `landmarks · π r² / area`. Multiplied by the number of hypotheses tried, this is the
+//! The null model drops each of the current station's detections anywhere among the frame's
+//! landmarks, independently. A motion hypothesised from two seed correspondences that also
+//! brings `j − 2` more detections within `r` of a frame landmark would do so by chance with
+//! probability at most the binomial tail of `j − 2` hits among the other detections, each with
+//! probability `density · π r²`, the density taken where the landmarks lie densest (rock
+//! fields cluster: the mean density would understate chance there). Multiplied by the number of hypotheses tried, this is the
 //! expected number of chance fits as tight as the one seen, its *number of false alarms*
 //! (NFA). A fit whose NFA is far below one is no accident, whatever the sensor's error bounds:
 //! the test uses the residuals the fit achieved, not the worst case the placement radii allow.
 
 use std::f64::consts::PI;
 
-/// The null model of one registration: how many hypotheses were tried, over what area the
-/// frame's landmarks lie, and how many detections could fall near them.
+/// The null model of one registration: how many hypotheses were tried, how densely the frame's
+/// landmarks lie, and how many detections could fall near them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Chance {
     /// Motions hypothesised (pairs of seed correspondences).
     pub tests: f64,
-    /// Area (m²) of the region holding the frame's landmarks.
-    pub area: f64,
-    /// Landmarks of the frame.
-    pub landmarks: usize,
+    /// Landmarks per m² where they lie densest: a chance detection near a cluster is more
+    /// likely to land near some landmark than the frame's mean density says.
+    pub density: f64,
     /// Detections of the current station that could pair with one.
     pub detections: usize,
 }
@@ -39,7 +39,7 @@ impl Chance {
         (min_inliers.max(3)..=sorted.len())
             .map(|j| {
                 let r = sorted[j - 1];
-                let p = (self.landmarks as f64 * PI * r * r / self.area).min(1.0);
+                let p = (self.density * PI * r * r).min(1.0);
                 (self.tests * binomial_tail(others, j - 2, p), j)
             })
             .min_by(|a, b| a.0.total_cmp(&b.0))
@@ -94,8 +94,7 @@ mod tests {
     fn tight_fits_are_significant_and_loose_ones_are_not() {
         let chance = Chance {
             tests: 700.0,
-            area: 400.0,
-            landmarks: 6,
+            density: 6.0 / 400.0,
             detections: 10,
         };
         let (tight, used) = chance.nfa(&[0.03, 0.07, 0.05, 0.04], 4);
@@ -104,7 +103,7 @@ mod tests {
         let (loose, _) = chance.nfa(&[0.5, 0.4, 0.6, 0.45], 4);
         assert!(loose > 1.0, "{loose}");
         let packed = Chance {
-            landmarks: 400,
+            density: 1.0,
             ..chance
         };
         assert!(packed.nfa(&[0.03, 0.07, 0.05, 0.04], 4).0 > 1.0);
@@ -115,8 +114,7 @@ mod tests {
     fn the_tightest_prefix_decides() {
         let chance = Chance {
             tests: 700.0,
-            area: 400.0,
-            landmarks: 6,
+            density: 6.0 / 400.0,
             detections: 10,
         };
         let core = chance.nfa(&[0.03, 0.07, 0.05, 0.04], 4).0;
