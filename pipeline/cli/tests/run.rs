@@ -75,8 +75,15 @@ fn maps_the_demo_dataset_soundly() {
         "summary.json",
         "eval.json",
         "run.mcap",
+        "landmarks.png",
     ] {
         assert!(out.join(file).is_file(), "{file} missing");
+    }
+    // One annotated panorama per station, at twice the demo's 1024 columns by default.
+    let panoramas = out.join("panoramas");
+    for station in 0..16 {
+        let path = panoramas.join(format!("station_{station:03}.png"));
+        assert_eq!(png_size(&path).0, 2048, "{}", path.display());
     }
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
@@ -124,6 +131,58 @@ fn maps_the_demo_dataset_soundly() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(json(&again.join("eval.json")), eval);
+}
+
+/// The (width, height) of the PNG at `path`, from its header.
+fn png_size(path: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{}", path.display());
+    let word = |at: usize| u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap());
+    (word(16), word(20))
+}
+
+/// `--panoramas full` draws at the panorama's own size, `none` writes none and removes the
+/// earlier run's, and a later run over fewer stations leaves none of the earlier ones behind.
+#[test]
+fn annotated_panoramas_follow_the_run() {
+    let images = demo_copy("pictures", 4);
+    let out = scratch("pictures-out");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "run",
+            "--images",
+            arg(&images),
+            "--out",
+            arg(&out),
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        let o = pipeline(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    let listed = || {
+        let mut names: Vec<String> = std::fs::read_dir(out.join("panoramas"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        names
+    };
+    run(&["--panoramas", "full"]);
+    assert_eq!(
+        listed(),
+        (0..4)
+            .map(|i| format!("station_{i:03}.png"))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(png_size(&out.join("panoramas/station_003.png")).0, 1024);
+    std::fs::remove_file(images.join("station_003_left.png")).unwrap();
+    std::fs::remove_file(images.join("station_003_right.png")).unwrap();
+    run(&["--no-eval"]);
+    assert_eq!(listed().len(), 3, "{:?}", listed());
+    run(&["--panoramas", "none", "--no-eval"]);
+    assert!(listed().is_empty(), "{:?}", listed());
+    assert!(out.join("landmarks.png").is_file());
 }
 
 /// Every output that counts landmarks counts the same ones: map.json, landmarks.json,
@@ -544,11 +603,14 @@ fn a_bad_image_is_skipped_with_a_warning() {
 fn an_interrupted_run_leaves_the_earlier_outputs_whole() {
     use std::process::{Command, Stdio};
     use std::time::{Duration, Instant};
-    const OUTPUTS: [&str; 9] = [
+    const OUTPUTS: [&str; 12] = [
         "map.json",
         "rng.json",
         "rng.png",
         "timing.png",
+        "landmarks.png",
+        "panoramas/station_000.png",
+        "panoramas/station_015.png",
         "stations.json",
         "landmarks.json",
         "summary.json",
@@ -584,8 +646,9 @@ fn an_interrupted_run_leaves_the_earlier_outputs_whole() {
             libc::kill(child.id() as libc::pid_t, signal);
         }
         let o = child.wait_with_output().unwrap();
-        let names: Vec<String> = std::fs::read_dir(&out)
-            .unwrap()
+        let names: Vec<String> = [out.to_path_buf(), out.join("panoramas")]
+            .iter()
+            .flat_map(|dir| std::fs::read_dir(dir).unwrap())
             .map(|e| e.unwrap().file_name().into_string().unwrap())
             .collect();
         assert!(

@@ -29,6 +29,8 @@ pub(super) enum Key {
     Ring(RGBColor),
     /// A filled triangle marker.
     Triangle(RGBColor),
+    /// An open box (a detection's outline on a panorama).
+    Box(RGBColor),
     /// The edge-cost colours for `0 < w ≤ 1`.
     CostScale,
 }
@@ -187,6 +189,10 @@ fn draw_swatch<DB: DrawingBackend>(
         Key::Circle(colour) => area.draw(&Circle::new(middle, 6, colour.filled())),
         Key::Ring(colour) => area.draw(&Circle::new(middle, 6, colour.stroke_width(2))),
         Key::Triangle(colour) => area.draw(&TriangleMarker::new(middle, 9, colour.filled())),
+        Key::Box(colour) => area.draw(&Rectangle::new(
+            [(x + 8, y - 8), (x + SWATCH_WIDTH - 8, y + 8)],
+            colour.stroke_width(2),
+        )),
         Key::CostScale => {
             for step in 0..SCALE_WIDTH {
                 let w = f64::from(step + 1) / f64::from(SCALE_WIDTH);

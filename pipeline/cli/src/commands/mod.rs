@@ -5,6 +5,7 @@ pub mod map;
 pub mod measure;
 pub mod navigate;
 pub mod output;
+pub mod pictures;
 pub mod run;
 pub mod simulate;
 pub mod synth;

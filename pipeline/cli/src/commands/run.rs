@@ -1,5 +1,6 @@
 //! `pipeline run --images DIR`: panoramas in, qualitative map and RNG out (docs/RUN.md).
 
+use super::pictures::{stage_pictures, PanoramaSize, RunImages};
 use super::rng_json;
 use crate::recording::{McapRecorder, Recorder, RngDrawing};
 use anyhow::{bail, Context, Result};
@@ -47,6 +48,11 @@ pub struct RunArgs {
     /// `auto` picks it for grayscale panoramas and JPEG stereo pairs, colour otherwise.
     #[arg(long, value_enum, default_value_t = ChannelsArg::Auto)]
     pub channels: ChannelsArg,
+    /// Annotated panoramas in OUT/panoramas/: `reduced` (scaled by a power of two to 1025-2048
+    /// pixels wide), `full` (their own size) or `none`. The landmark contact sheet
+    /// (OUT/landmarks.png) is written in every case.
+    #[arg(long, value_enum, default_value_t = PanoramaSize::Reduced)]
+    pub panoramas: PanoramaSize,
     /// No progress bars and no warning lines while running: the warnings are counted by kind
     /// at the end (each station's are in stations.json).
     #[arg(long)]
@@ -257,6 +263,16 @@ pub fn run(args: RunArgs) -> Result<()> {
     // replaced or none are (an interrupt before the pass leaves them as they were).
     let mut outputs = OutputSet::new();
     stage_outputs(&mut outputs, &args.out, &traverse.mapper, &traverse.records)?;
+    let landmarks = traverse.mapper.landmarks();
+    let images = RunImages {
+        directory: &survey.directory,
+        size: (calib.image.width, calib.image.height),
+        records: &traverse.records,
+        landmarks: &landmarks,
+    };
+    for warning in stage_pictures(&mut outputs, &args.out, &images, args.panoramas)? {
+        bars.warn(&warning);
+    }
     for recorder in recorders {
         outputs.adopt(recorder.finish()?);
     }
