@@ -76,6 +76,7 @@ fn maps_the_demo_dataset_soundly() {
         "eval.json",
         "run.mcap",
         "landmarks.png",
+        "rng_truth.png",
     ] {
         assert!(out.join(file).is_file(), "{file} missing");
     }
@@ -142,7 +143,8 @@ fn png_size(path: &Path) -> (u32, u32) {
 }
 
 /// `--panoramas full` draws at the panorama's own size, `none` writes none and removes the
-/// earlier run's, and a later run over fewer stations leaves none of the earlier ones behind.
+/// earlier run's, and a later run over fewer stations leaves none of the earlier ones behind;
+/// rng_truth.png goes with the scoring that drew it.
 #[test]
 fn annotated_panoramas_follow_the_run() {
     let images = demo_copy("pictures", 4);
@@ -178,8 +180,13 @@ fn annotated_panoramas_follow_the_run() {
     assert_eq!(png_size(&out.join("panoramas/station_003.png")).0, 1024);
     std::fs::remove_file(images.join("station_003_left.png")).unwrap();
     std::fs::remove_file(images.join("station_003_right.png")).unwrap();
+    assert!(out.join("rng_truth.png").is_file());
     run(&["--no-eval"]);
     assert_eq!(listed().len(), 3, "{:?}", listed());
+    assert!(
+        !out.join("rng_truth.png").exists(),
+        "an earlier scoring's picture is not this run's"
+    );
     run(&["--panoramas", "none", "--no-eval"]);
     assert!(listed().is_empty(), "{:?}", listed());
     assert!(out.join("landmarks.png").is_file());
@@ -603,7 +610,8 @@ fn a_bad_image_is_skipped_with_a_warning() {
 fn an_interrupted_run_leaves_the_earlier_outputs_whole() {
     use std::process::{Command, Stdio};
     use std::time::{Duration, Instant};
-    const OUTPUTS: [&str; 12] = [
+    const OUTPUTS: [&str; 13] = [
+        "rng_truth.png",
         "map.json",
         "rng.json",
         "rng.png",

@@ -1,7 +1,7 @@
 //! Snapshots of the relative neighbourhood graph estimated from the qualitative map, as in
 //! 000 Fig. 11 (§VII, §VIII-C): landmarks at their ground-truth positions (used only to place
 //! them), estimated RNG edges coloured by their cost `w` (Algorithm 2), the true RNG dashed
-//! underneath for comparison, and the imaging points with the latest one highlighted. Both
+//! over them for comparison, and the imaging points with the latest one highlighted. Both
 //! axes share one scale so that lunes and distances look as they are.
 
 use super::cost_colour::cost_colour;
@@ -35,7 +35,7 @@ pub struct RngPicture<'a> {
     /// Estimated edges `(i, j, w)` between landmark indices with cost `w ∈ [0, 1]`: black for
     /// `w = 0`, then dark blue → red as `w → 1`.
     pub edges: &'a [(usize, usize, f64)],
-    /// Edges of the true RNG, drawn dashed and grey underneath (may be empty).
+    /// Edges of the true RNG, drawn dashed in orange over the estimate (may be empty).
     pub true_edges: &'a [(usize, usize)],
     /// Imaging points in order (green triangles); the last one is drawn red.
     pub stations: &'a [(f64, f64)],
@@ -48,7 +48,9 @@ const Y_LABEL_AREA: u32 = 64;
 const LANDMARK: RGBColor = RGBColor(31, 90, 220);
 const STATION: RGBColor = RGBColor(20, 160, 40);
 const LATEST_STATION: RGBColor = RGBColor(230, 0, 0);
-const TRUE_EDGE: RGBColor = RGBColor(160, 160, 160);
+/// Drawn dashed over the estimate, so that the true edges among the estimated ones stand out
+/// (under it, every true edge the estimate keeps would be hidden).
+const TRUE_EDGE: RGBColor = RGBColor(255, 170, 0);
 
 /// Writes `picture` to `path`; format by extension: `.png` (900×900 pixels) or `.svg`.
 ///
@@ -206,9 +208,6 @@ impl Figure for RngPicture<'_> {
             .draw()?;
 
         let at = |i: usize| self.landmarks[i];
-        chart.draw_series(self.true_edges.iter().map(|&(i, j)| {
-            DashedPathElement::new([at(i), at(j)], 7, 5, TRUE_EDGE.stroke_width(2))
-        }))?;
         // Contested edges last, so that red is not hidden under black.
         let mut edges = self.edges.to_vec();
         edges.sort_by(|a, b| a.2.total_cmp(&b.2));
@@ -217,6 +216,9 @@ impl Figure for RngPicture<'_> {
                 .iter()
                 .map(|&(i, j, w)| PathElement::new([at(i), at(j)], cost_colour(w).stroke_width(3))),
         )?;
+        chart.draw_series(self.true_edges.iter().map(|&(i, j)| {
+            DashedPathElement::new([at(i), at(j)], 7, 5, TRUE_EDGE.stroke_width(2))
+        }))?;
         if let Some((latest, earlier)) = self.stations.split_last() {
             chart.draw_series(
                 earlier

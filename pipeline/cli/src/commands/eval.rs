@@ -1,17 +1,20 @@
 //! `pipeline eval --run OUT --truth truth.json`: scores a run against the renderer's truth
-//! (docs/RUN.md): eval.json and a printed report.
+//! (docs/RUN.md): eval.json, rng_truth.png and a printed report.
 
-use super::output::write_atomic;
+use super::rng_picture::{stage_rng_truth, EdgeCut};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
+use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
-use qrm_core::map::Hypergraph;
+use qrm_core::map::{Hypergraph, LandmarkId};
+use qrm_core::neighborhood::estimate;
 use qrm_synth::dataset::Truth;
 use qrm_synth::evaluation::{self, Detectable, Evaluation, RunFiles};
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::DetectorSettings;
 use qrm_vision::run::{LandmarkRecord, StationRecord};
 use qrm_vision::survey::{self, Survey};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -25,9 +28,12 @@ pub struct EvalArgs {
     /// The calibration the run used (default: calib.toml beside the truth file).
     #[arg(long)]
     pub calib: Option<PathBuf>,
-    /// Where eval.json goes (default: the run directory).
+    /// Where eval.json and rng_truth.png go (default: the run directory).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Draw every possible RNG edge in rng_truth.png, not only those of cost w ≤ 0.15.
+    #[arg(long)]
+    pub all_edges: bool,
 }
 
 pub fn run(args: EvalArgs) -> Result<()> {
@@ -37,7 +43,8 @@ pub fn run(args: EvalArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| args.truth.with_file_name("calib.toml"));
     let calib = Calibration::load(&calib_path)?;
-    print_report(&score_run_files(&args.run, &args.truth, &calib, &out)?);
+    let cut = EdgeCut::new(args.all_edges);
+    print_report(&score_run_files(&args.run, &args.truth, &calib, &out, cut)?);
     Ok(())
 }
 
@@ -69,12 +76,14 @@ pub fn check_survey(truth: &Truth, survey: &Survey) -> Result<()> {
     Ok(())
 }
 
-/// Scores the run in `run_dir` against `truth_path`, writing `eval.json` into `out`.
+/// Scores the run in `run_dir` against `truth_path`, writing `eval.json` and `rng_truth.png`
+/// (the RNG estimate at the true rock positions, edges cut by `cut`) into `out`, together.
 pub fn score_run_files(
     run_dir: &Path,
     truth_path: &Path,
     calib: &Calibration,
     out: &Path,
+    cut: EdgeCut,
 ) -> Result<Evaluation> {
     let truth = read_truth(truth_path)?;
     let records: Vec<StationRecord> = read(&run_dir.join("stations.json"))?;
@@ -102,10 +111,45 @@ pub fn score_run_files(
         calib,
         Detectable::of(&settings),
     );
-    write_atomic(
-        &out.join("eval.json"),
-        (serde_json::to_string_pretty(&eval)? + "\n").as_bytes(),
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create directory {}", out.display()))?;
+    let mut outputs = OutputSet::new();
+    let eval_path = out.join("eval.json");
+    outputs
+        .stage_bytes(
+            &eval_path,
+            (serde_json::to_string_pretty(&eval)? + "\n").as_bytes(),
+        )
+        .with_context(|| format!("cannot write {}", eval_path.display()))?;
+    let rocks: BTreeMap<LandmarkId, [f64; 2]> = eval
+        .landmark_rocks
+        .iter()
+        .filter(|(l, _)| map.landmarks().contains(l))
+        .map(|(&l, &r)| (l, truth.rocks[r as usize].position))
+        .collect();
+    let stations: Vec<(f64, f64)> = records
+        .iter()
+        .filter_map(|r| {
+            let image = truth
+                .images
+                .iter()
+                .find(|i| Some(&i.file) == r.files.first())?;
+            let p = truth.stations.get(image.station)?.position;
+            Some((p[0], p[1]))
+        })
+        .collect();
+    let rng = estimate(&map).unwrap_or_default();
+    stage_rng_truth(
+        &mut outputs,
+        &out.join("rng_truth.png"),
+        &rng,
+        &rocks,
+        &stations,
+        cut,
     )?;
+    outputs
+        .commit()
+        .with_context(|| format!("cannot move the scores into {}", out.display()))?;
     Ok(eval)
 }
 
@@ -178,6 +222,17 @@ pub fn print_report(e: &Evaluation) {
                 "  RNG ({name:<5}): precision {:.2}, recall {:.2}, {} true edges pruned, over the {} one-rock landmarks",
                 rng.precision, rng.recall, rng.true_edges_pruned, rng.landmarks
             );
+            let cuts: Vec<String> = rng
+                .by_cost
+                .iter()
+                .map(|c| {
+                    format!(
+                        "w ≤ {:.2}: {} edges, {:.2}/{:.2}",
+                        c.max_cost, c.edges, c.precision, c.recall
+                    )
+                })
+                .collect();
+            println!("    by cost (precision/recall): {}", cuts.join("; "));
         }
     }
 }

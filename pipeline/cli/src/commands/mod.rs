@@ -6,6 +6,7 @@ pub mod measure;
 pub mod navigate;
 pub mod output;
 pub mod pictures;
+pub mod rng_picture;
 pub mod run;
 pub mod simulate;
 pub mod synth;

@@ -2,6 +2,7 @@
 
 use super::pictures::{stage_pictures, PanoramaSize, RunImages};
 use super::rng_json;
+use super::rng_picture::{stage_rng_png, EdgeCut, DEFAULT_MAX_COST};
 use crate::recording::{McapRecorder, Recorder, RngDrawing};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -11,7 +12,7 @@ use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
 use qrm_core::neighborhood::RngEstimate;
-use qrm_plot::{spring_layout, write_panels, write_rng, Curve, Panel, RngPicture};
+use qrm_plot::{spring_layout, write_panels, Curve, Panel};
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::Channels;
 use qrm_vision::run::{
@@ -53,6 +54,10 @@ pub struct RunArgs {
     /// (OUT/landmarks.png) is written in every case.
     #[arg(long, value_enum, default_value_t = PanoramaSize::Reduced)]
     pub panoramas: PanoramaSize,
+    /// Draw every possible RNG edge in rng.png (and rng_truth.png), not only those of cost
+    /// w ≤ 0.15 (docs/RUN.md, "Pictures").
+    #[arg(long)]
+    pub all_edges: bool,
     /// No progress bars and no warning lines while running: the warnings are counted by kind
     /// at the end (each station's are in stations.json).
     #[arg(long)]
@@ -262,7 +267,14 @@ pub fn run(args: RunArgs) -> Result<()> {
     // Every output is staged and then renamed in one pass: an earlier run's files are all
     // replaced or none are (an interrupt before the pass leaves them as they were).
     let mut outputs = OutputSet::new();
-    stage_outputs(&mut outputs, &args.out, &traverse.mapper, &traverse.records)?;
+    let cut = EdgeCut::new(args.all_edges);
+    stage_outputs(
+        &mut outputs,
+        &args.out,
+        &traverse.mapper,
+        &traverse.records,
+        cut,
+    )?;
     let landmarks = traverse.mapper.landmarks();
     let images = RunImages {
         directory: &survey.directory,
@@ -285,6 +297,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     // A scoring left from an earlier run into the same directory would not be this run's; the
     // new one is written after the run's files are in place.
     outputs.remove_stale(&args.out.join("eval.json"));
+    outputs.remove_stale(&args.out.join("rng_truth.png"));
     outputs
         .commit()
         .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
@@ -294,7 +307,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     });
     let evaluation = match (truth, args.no_eval) {
         (Some(truth), false) => Some(super::eval::score_run_files(
-            &args.out, &truth, &calib, &args.out,
+            &args.out, &truth, &calib, &args.out, cut,
         )?),
         _ => None,
     };
@@ -365,8 +378,23 @@ fn print_summary(summary: &RunSummary, out: &Path, started: Instant) {
         started.elapsed().as_secs_f64(),
         out.display()
     );
-    if out.join("rng.png").exists() {
-        println!("  look at {} (the RNG)", out.join("rng.png").display());
+    let pictures: Vec<String> = [
+        (
+            "rng.png",
+            format!("the RNG; edges of cost w ≤ {DEFAULT_MAX_COST} unless --all-edges"),
+        ),
+        ("landmarks.png", "every landmark's best view".to_string()),
+        ("panoramas", "each station's detections".to_string()),
+    ]
+    .into_iter()
+    .filter(|(name, _)| {
+        let path = out.join(name);
+        path.is_file() || std::fs::read_dir(&path).is_ok_and(|mut d| d.next().is_some())
+    })
+    .map(|(name, what)| format!("{} ({what})", out.join(name).display()))
+    .collect();
+    if !pictures.is_empty() {
+        println!("  look at {}", pictures.join(", "));
     }
     println!(
         "  the map is {} (docs/MAP_FORMAT.md); everything per station is in {} (docs/RUN_OUTPUTS.md)",
@@ -405,12 +433,13 @@ fn stage(outputs: &mut OutputSet, path: &Path, bytes: &[u8]) -> Result<()> {
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// map.json, rng.json, rng.png, stations.json, landmarks.json, staged.
+/// map.json, rng.json, rng.png, timing.png, stations.json, landmarks.json, staged.
 fn stage_outputs(
     outputs: &mut OutputSet,
     out: &Path,
     mapper: &Mapper<Edc>,
     records: &[StationRecord],
+    cut: EdgeCut,
 ) -> Result<()> {
     stage(
         outputs,
@@ -422,43 +451,14 @@ fn stage_outputs(
         &out.join("rng.json"),
         rng_json(&mapper.map, mapper.rng()).as_bytes(),
     )?;
-    let drawing = rng_drawing(&mapper.map, mapper.rng());
-    if !drawing.landmarks.is_empty() {
-        let index = |id: u32| {
-            drawing
-                .landmarks
-                .iter()
-                .position(|l| l.0 == id)
-                .expect("edge of the map")
-        };
-        let positions: Vec<(f64, f64)> =
-            drawing.landmarks.iter().map(|l| (l.1[0], l.1[1])).collect();
-        let labels: Vec<String> = drawing.landmarks.iter().map(|l| l.0.to_string()).collect();
-        let edges: Vec<(usize, usize, f64)> = drawing
-            .edges
-            .iter()
-            .map(|&(a, b, cost)| (index(a), index(b), cost))
-            .collect();
-        let picture = RngPicture {
-            title: format!(
-                "RNG after {} stations: {} landmarks, {} possible edges",
-                records.len(),
-                positions.len(),
-                edges.len()
-            ),
-            landmarks: &positions,
-            labels: &labels,
-            metric: false,
-            edges: &edges,
-            true_edges: &[],
-            stations: &[],
-        };
-        outputs.stage(&out.join("rng.png"), |temporary| {
-            write_rng(temporary, &picture)
-        })?;
-    } else {
-        outputs.remove_stale(&out.join("rng.png"));
-    }
+    stage_rng_png(
+        outputs,
+        &out.join("rng.png"),
+        mapper.map.landmarks(),
+        mapper.rng(),
+        records.len(),
+        cut,
+    )?;
     if !records.is_empty() {
         outputs.stage(&out.join("timing.png"), |temporary| {
             write_panels(temporary, "station", &timing_panels(records))

@@ -4,7 +4,7 @@ use super::detection::ratio;
 use super::AssociationScore;
 use qrm_core::map::LandmarkId;
 use qrm_vision::run::LandmarkRecord;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// Which truth rock each landmark stands for.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -17,6 +17,11 @@ impl LandmarkRocks {
     /// The rock most of the landmark's sightings show.
     pub fn majority(&self, l: LandmarkId) -> Option<u32> {
         self.majority.get(&l).copied()
+    }
+
+    /// Every landmark's rock.
+    pub fn all(&self) -> BTreeMap<LandmarkId, u32> {
+        self.majority.iter().map(|(&l, &r)| (l, r)).collect()
     }
 
     /// The landmark's rock if no other landmark stands for it: the landmarks with a truth.

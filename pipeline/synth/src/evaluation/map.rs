@@ -3,7 +3,7 @@
 
 use super::association::LandmarkRocks;
 use super::detection::ratio;
-use super::{eval_records, MapMetricsScore, MapScore, RngScore, RunFiles};
+use super::{eval_records, CostCut, MapMetricsScore, MapScore, RngScore, RunFiles, COST_CUTS};
 use crate::dataset::Truth;
 use qrm_core::calculus::Calculus;
 use qrm_core::edc::Edc;
@@ -11,7 +11,7 @@ use qrm_core::geometry::Point;
 use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
 use qrm_core::measurement::{Bearing, RangeOrder, StationView};
 use qrm_core::metrics::evaluate;
-use qrm_core::neighborhood::{compare, estimate};
+use qrm_core::neighborhood::{compare, estimate, RngEstimate};
 use std::collections::HashMap;
 use std::f64::consts::TAU;
 
@@ -39,12 +39,35 @@ pub(super) fn score(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> Map
             return None;
         }
         let estimate = estimate(&map)?;
-        let comparison = compare(&map, &estimate, |l| position(l).expect("restricted"));
+        let at = |l: LandmarkId| position(l).expect("restricted");
+        let comparison = compare(&map, &estimate, at);
+        let by_cost = COST_CUTS
+            .iter()
+            .map(|&max_cost| {
+                let kept = RngEstimate {
+                    edges: estimate
+                        .edges
+                        .iter()
+                        .filter(|e| e.cost <= max_cost)
+                        .copied()
+                        .collect(),
+                    pruned: estimate.pruned,
+                };
+                let cut = compare(&map, &kept, at);
+                CostCut {
+                    max_cost,
+                    edges: kept.edges.len(),
+                    precision: cut.precision(),
+                    recall: cut.recall(),
+                }
+            })
+            .collect();
         Some(RngScore {
             landmarks: map.len(),
             precision: comparison.precision(),
             recall: comparison.recall(),
             true_edges_pruned: comparison.pruned_true,
+            by_cost,
         })
     };
     MapScore {

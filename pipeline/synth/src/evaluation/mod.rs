@@ -16,6 +16,7 @@ use qrm_core::map::{Hypergraph, LandmarkId};
 use qrm_vision::calib::Calibration;
 use qrm_vision::run::{LandmarkRecord, StationRecord};
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Evaluation {
@@ -26,6 +27,9 @@ pub struct Evaluation {
     pub bearing_used: BearingScore,
     pub range: RangeScore,
     pub association: AssociationScore,
+    /// The rock each landmark stands for: the one most of its sightings show (landmarks made
+    /// only of false detections have none).
+    pub landmark_rocks: BTreeMap<LandmarkId, u32>,
     pub map: MapScore,
 }
 
@@ -133,6 +137,21 @@ pub struct RngScore {
     pub precision: f64,
     pub recall: f64,
     pub true_edges_pruned: usize,
+    /// The same for only the edges of cost `w ≤ max_cost` (Algorithm 2's `w`), at each of
+    /// [`COST_CUTS`]: what rng.png shows by default, and how much a cut loses.
+    pub by_cost: Vec<CostCut>,
+}
+
+/// The cost cuts at which [`RngScore::by_cost`] is reported.
+pub const COST_CUTS: [f64; 6] = [0.05, 0.1, 0.15, 0.2, 0.25, 0.3];
+
+/// Precision and recall of the RNG edges of cost at most `max_cost`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct CostCut {
+    pub max_cost: f64,
+    pub edges: usize,
+    pub precision: f64,
+    pub recall: f64,
 }
 
 /// Checks that `truth`, `records` and `landmarks` (read from files) refer to each other
@@ -239,6 +258,7 @@ pub fn score_run(
         bearing_used,
         range,
         association,
+        landmark_rocks: rocks.all(),
         map: map::score(run, truth, &rocks),
     }
 }
