@@ -344,3 +344,55 @@ fn closes_and_checks_constraint_networks() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("line 2"));
 }
+
+/// `map realize` places a simulated map's landmarks so that every relation holds, writes the
+/// positions and a picture together, and refuses a map it cannot read with nothing written.
+#[test]
+fn realizes_a_map() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let o = pipeline(&[
+        "simulate",
+        "single",
+        "--landmarks",
+        "12",
+        "--stations",
+        "20",
+        "--out",
+        &path("sim"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = pipeline(&[
+        "map",
+        "realize",
+        &path("sim/map.json"),
+        "--out",
+        &path("layout/real.json"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        stdout(&o).contains("constrained relations holds"),
+        "{}",
+        stdout(&o)
+    );
+    let layout: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("layout/real.json")).unwrap())
+            .unwrap();
+    assert_eq!(layout["format"], "qrm-realization");
+    assert_eq!(layout["exact"], true);
+    assert_eq!(layout["violated"], 0);
+    assert_eq!(layout["landmarks"].as_array().unwrap().len(), 12);
+    assert!(dir.join("layout/real.png").is_file());
+    std::fs::write(dir.join("not-a-map.json"), "{\"calculus\": \"EDC\"}").unwrap();
+    let o = pipeline(&[
+        "map",
+        "realize",
+        &path("not-a-map.json"),
+        "--out",
+        &path("bad.json"),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not-a-map.json"));
+    assert!(!dir.join("bad.json").exists() && !dir.join("bad.png").exists());
+}

@@ -5,7 +5,7 @@
 //! cargo run --release -p qrm-plot --example plot_demo -- /tmp/plot-example.png /tmp/rng-example.png
 //! ```
 
-use qrm_plot::{write_panels, write_rng, Curve, Panel, RngPicture};
+use qrm_plot::{write_panels, write_rng, Axes, Curve, Panel, RngPicture};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
@@ -128,7 +128,7 @@ fn main() -> anyhow::Result<()> {
             title: "RNG estimate after image 15".into(),
             landmarks: &landmarks,
             labels: &labels,
-            metric: true,
+            axes: Axes::Metres,
             edges: &edges,
             true_edges: &true_edges,
             stations: &stations,

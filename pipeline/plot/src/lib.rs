@@ -28,7 +28,7 @@ pub use flow::{write_flow, FlowPicture};
 pub use layout::spring_layout;
 pub use panels::{write_panels, Curve, Panel};
 pub use panorama::{write_panorama, AnnotatedPanorama, Mark, MarkKind, RgbImage};
-pub use rng::{write_rng, RngPicture};
+pub use rng::{write_rng, Axes, RngPicture};
 
 #[cfg(test)]
 mod test_support;

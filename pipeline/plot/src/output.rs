@@ -98,7 +98,7 @@ fn render(
 mod tests {
     use super::Format;
     use crate::test_support::{file_names, scratch_dir};
-    use crate::{write_rng, PlotError, RngPicture};
+    use crate::{write_rng, Axes, PlotError, RngPicture};
     use std::path::Path;
 
     #[test]
@@ -120,7 +120,7 @@ mod tests {
             title: "t".into(),
             landmarks: &[(0.0, 0.0), (1.0, 1.0)],
             labels: &[],
-            metric: true,
+            axes: Axes::Metres,
             edges: &[(0, 1, 0.5)],
             true_edges: &[],
             stations: &[],
@@ -146,7 +146,7 @@ mod tests {
             title: "new".into(),
             landmarks: &[(0.0, 0.0)],
             labels: &[],
-            metric: false,
+            axes: Axes::Layout,
             edges: &[],
             true_edges: &[],
             stations: &[],

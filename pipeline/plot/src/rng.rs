@@ -20,6 +20,18 @@ use plotters::style::{Color, IntoFont, RGBColor, WHITE};
 use std::ops::Range;
 use std::path::Path;
 
+/// What an RNG picture's positions are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axes {
+    /// Metres (ground truth, simulated fields): numbered axes on one scale.
+    Metres,
+    /// A graph layout made for drawing: the axes carry no numbers, which would mean nothing.
+    Layout,
+    /// A realization of the map (`Hypergraph::realize`): one of the layouts its relations
+    /// allow, so arrangements mean something but distances and scale do not.
+    Realization,
+}
+
 /// An RNG estimate over landmark positions (000 Fig. 11 style).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RngPicture<'a> {
@@ -29,9 +41,8 @@ pub struct RngPicture<'a> {
     pub landmarks: &'a [(f64, f64)],
     /// Each landmark's name (its map id), drawn beside it; empty: none drawn.
     pub labels: &'a [String],
-    /// Whether the positions are metric (ground truth): otherwise (a graph layout) the axes
-    /// carry no numbers, which would mean nothing.
-    pub metric: bool,
+    /// What the positions are, which says what the axes may show.
+    pub axes: Axes,
     /// Estimated edges `(i, j, w)` between landmark indices with cost `w ∈ [0, 1]`: black for
     /// `w = 0`, then dark blue → red as `w → 1`.
     pub edges: &'a [(usize, usize, f64)],
@@ -188,19 +199,23 @@ impl Figure for RngPicture<'_> {
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(x_range, y_range)?;
         let blank = |_: &f64| String::new();
-        let (x_desc, y_desc) = if self.metric {
-            ("x (m)", "y (m)")
-        } else {
-            ("graph layout: positions carry no distances", "")
+        let metric = self.axes == Axes::Metres;
+        let (x_desc, y_desc) = match self.axes {
+            Axes::Metres => ("x (m)", "y (m)"),
+            Axes::Layout => ("graph layout: positions carry no distances", ""),
+            Axes::Realization => (
+                "one realization: every relation of the map holds here; the map allows many others",
+                "",
+            ),
         };
         let mut mesh = chart.configure_mesh();
-        if !self.metric {
+        if !metric {
             mesh.disable_mesh();
         }
         mesh.x_desc(x_desc)
             .y_desc(y_desc)
-            .x_label_formatter(if self.metric { &x_ticks } else { &blank })
-            .y_label_formatter(if self.metric { &y_ticks } else { &blank })
+            .x_label_formatter(if metric { &x_ticks } else { &blank })
+            .y_label_formatter(if metric { &y_ticks } else { &blank })
             .label_style((FAMILY, 17).into_font())
             .axis_desc_style((FAMILY, 20).into_font())
             .light_line_style(WHITE)
@@ -246,7 +261,7 @@ impl Figure for RngPicture<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::{equal_aspect, write_rng, RngPicture, SIZE};
+    use super::{equal_aspect, write_rng, Axes, RngPicture, SIZE};
     use crate::test_support::{file_names, png_size, scratch_dir};
     use crate::PlotError;
 
@@ -262,7 +277,7 @@ mod tests {
             title: "after image 2".into(),
             landmarks: &LANDMARKS,
             labels: LABELS.as_slice(),
-            metric: true,
+            axes: Axes::Metres,
             edges: &EDGES,
             true_edges: &TRUE_EDGES,
             stations: &STATIONS,
@@ -293,7 +308,7 @@ mod tests {
             title: String::new(),
             landmarks: &LANDMARKS[..1],
             labels: &[],
-            metric: false,
+            axes: Axes::Layout,
             edges: &[],
             true_edges: &[],
             stations: &[],

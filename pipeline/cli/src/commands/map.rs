@@ -1,14 +1,18 @@
-//! `pipeline map`: inspect and merge saved maps (format in docs/MAP_FORMAT.md).
+//! `pipeline map`: inspect, merge, close, check and realize saved maps (format in
+//! docs/MAP_FORMAT.md).
 
 use super::output::write_atomic;
+use super::rng_picture::{stage_rng_over, EdgeCut};
 use super::CalculusName;
 use anyhow::{bail, Context, Result};
 use clap::Subcommand;
+use qrm_atomic_file::OutputSet;
 use qrm_core::calculus::Calculus;
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
-use qrm_core::map::{Hypergraph, Network, Observation};
+use qrm_core::map::{Hypergraph, Network, Observation, RealizeSettings};
 use qrm_core::neighborhood::estimate;
+use qrm_plot::Axes;
 use std::path::{Path, PathBuf};
 
 #[derive(Subcommand, Debug)]
@@ -39,6 +43,31 @@ pub enum MapCommand {
         /// Calculus of a text network (a JSON file names its own).
         #[arg(long, value_enum, default_value = "edc")]
         calculus: CalculusName,
+    },
+    /// Find positions for the landmarks under which every relation of a map holds (one
+    /// realization, a witness layout) and draw the map there: `--out` gets the positions as
+    /// JSON, `--picture` (default: beside it, .png) the landmarks with the RNG estimate's edges
+    /// of cost w ≤ 0.15 (EDC). Exit 1 if the search ends with relations still violated (the
+    /// files then hold the best layout found, marked as such).
+    Realize {
+        file: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        /// The picture (.png or .svg).
+        #[arg(long)]
+        picture: Option<PathBuf>,
+        /// Seed of the search: the same seed gives the same layout.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Rounds in which every landmark is offered one move, per start.
+        #[arg(long, default_value_t = 2000)]
+        sweeps: usize,
+        /// Fresh random starts tried until one satisfies every relation.
+        #[arg(long, default_value_t = 4)]
+        restarts: usize,
+        /// Draw every possible RNG edge, not only those of cost w ≤ 0.15.
+        #[arg(long)]
+        all_edges: bool,
     },
     /// Check a constraint network (map JSON or text, as for `close`): exit 0 and say how much
     /// closing would tighten it if it is consistent, exit 1 and list a minimal set of
@@ -98,6 +127,33 @@ pub fn run_command(command: MapCommand) -> Result<()> {
                 other => bail!("{}: unknown calculus {other:?}", file.display()),
             };
             if !consistent {
+                std::process::exit(1);
+            }
+            Ok(())
+        }
+        MapCommand::Realize {
+            file,
+            out,
+            picture,
+            seed,
+            sweeps,
+            restarts,
+            all_edges,
+        } => {
+            let text = read(&file)?;
+            let settings = RealizeSettings {
+                seed,
+                sweeps,
+                restarts,
+            };
+            let picture = picture.unwrap_or_else(|| out.with_extension("png"));
+            let cut = EdgeCut::new(all_edges);
+            let exact = match calculus_of(&file, &text)?.as_str() {
+                "EDC" => realize(&load::<Edc>(&file, &text)?, &settings, &out, &picture, cut)?,
+                "FDC" => realize(&load::<Fdc>(&file, &text)?, &settings, &out, &picture, cut)?,
+                other => bail!("{}: unknown calculus {other:?}", file.display()),
+            };
+            if !exact {
                 std::process::exit(1);
             }
             Ok(())
@@ -170,6 +226,86 @@ fn merge<C: Calculus>(files: &[PathBuf], out: &Path) -> Result<()> {
         out.display()
     );
     Ok(())
+}
+
+/// Realizes `map`, writes the layout to `out` and its picture to `picture` (together);
+/// whether every relation holds there.
+fn realize<C: Calculus>(
+    map: &Hypergraph<C>,
+    settings: &RealizeSettings,
+    out: &Path,
+    picture: &Path,
+    cut: EdgeCut,
+) -> Result<bool> {
+    if map.is_empty() {
+        bail!("the map has no landmarks to place");
+    }
+    let found = map.realize(settings);
+    let verdict = if found.is_exact() {
+        format!(
+            "every one of its {} constrained relations holds",
+            found.constrained
+        )
+    } else {
+        format!(
+            "not a realization: {} of {} constrained relations still violated",
+            found.violated, found.constrained
+        )
+    };
+    let json = serde_json::json!({
+        "format": "qrm-realization",
+        "version": 1,
+        "calculus": C::NAME,
+        "exact": found.is_exact(),
+        "violated": found.violated,
+        "constrained": found.constrained,
+        "landmarks": found
+            .landmarks
+            .iter()
+            .zip(&found.positions)
+            .map(|(id, p)| serde_json::json!({"landmark": id, "x": p.x, "y": p.y}))
+            .collect::<Vec<_>>(),
+    });
+    let mut outputs = OutputSet::new();
+    for path in [out, picture] {
+        if let Some(dir) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create directory {}", dir.display()))?;
+        }
+    }
+    outputs
+        .stage_bytes(
+            out,
+            (serde_json::to_string_pretty(&json)? + "\n").as_bytes(),
+        )
+        .with_context(|| format!("cannot write {}", out.display()))?;
+    let rng = estimate(map).unwrap_or_default();
+    let positions: Vec<(f64, f64)> = found.positions.iter().map(|p| (p.x, p.y)).collect();
+    let title = if found.is_exact() {
+        format!("One realization of the {} map", C::NAME)
+    } else {
+        format!("Best layout found, {} relations violated", found.violated)
+    };
+    stage_rng_over(
+        &mut outputs,
+        picture,
+        title,
+        (&found.landmarks, &positions),
+        &rng,
+        cut,
+        Axes::Realization,
+    )?;
+    outputs
+        .commit()
+        .with_context(|| format!("cannot move {} into place", out.display()))?;
+    println!(
+        "{} map of {} landmarks placed: {verdict}; wrote {} and {}",
+        C::NAME,
+        map.len(),
+        out.display(),
+        picture.display()
+    );
+    Ok(found.is_exact())
 }
 
 /// Whether `path` holds JSON (by its extension).

@@ -8,9 +8,10 @@
 
 use anyhow::Result;
 use qrm_atomic_file::OutputSet;
+use qrm_core::geometry::Point;
 use qrm_core::map::LandmarkId;
 use qrm_core::neighborhood::{true_rng, RngEstimate};
-use qrm_plot::{spring_layout, write_rng, RngPicture};
+use qrm_plot::{spring_layout, write_rng, Axes, RngPicture};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -66,25 +67,21 @@ pub fn stage_rng_png(
         outputs.remove_stale(path);
         return Ok(());
     }
-    let edges = cut.edges(ids, rng);
-    let pairs: Vec<(usize, usize)> = edges.iter().map(|&(i, j, _)| (i, j)).collect();
+    let pairs: Vec<(usize, usize)> = cut
+        .edges(ids, rng)
+        .iter()
+        .map(|&(i, j, _)| (i, j))
+        .collect();
     let positions = spring_layout(ids.len(), &pairs);
-    let labels: Vec<String> = ids.iter().map(|id| id.to_string()).collect();
-    let picture = RngPicture {
-        title: format!(
-            "RNG after {stations} stations: {} landmarks, {}",
-            ids.len(),
-            cut.describe(edges.len(), rng.edges.len())
-        ),
-        landmarks: &positions,
-        labels: &labels,
-        metric: false,
-        edges: &edges,
-        true_edges: &[],
-        stations: &[],
-    };
-    outputs.stage(path, |temporary| write_rng(temporary, &picture))?;
-    Ok(())
+    stage_rng_over(
+        outputs,
+        path,
+        format!("RNG after {stations} stations"),
+        (ids, &positions),
+        rng,
+        cut,
+        Axes::Layout,
+    )
 }
 
 /// Stages `path` (rng_truth.png): the landmarks that stand for a rock at that rock's true
@@ -104,11 +101,7 @@ pub fn stage_rng_truth(
     }
     let ids: Vec<LandmarkId> = rocks.keys().copied().collect();
     let positions: Vec<(f64, f64)> = rocks.values().map(|p| (p[0], p[1])).collect();
-    let points: Vec<qrm_core::geometry::Point> = positions
-        .iter()
-        .map(|&(x, y)| qrm_core::geometry::Point::new(x, y))
-        .collect();
-    let true_edges = true_rng(&points);
+    let points: Vec<Point> = positions.iter().map(|&(x, y)| Point::new(x, y)).collect();
     let edges = cut.edges(&ids, rng);
     let possible = EdgeCut { max_cost: None }.edges(&ids, rng).len();
     let labels: Vec<String> = ids.iter().map(|id| id.to_string()).collect();
@@ -120,10 +113,40 @@ pub fn stage_rng_truth(
         ),
         landmarks: &positions,
         labels: &labels,
-        metric: true,
+        axes: Axes::Metres,
         edges: &edges,
-        true_edges: &true_edges,
+        true_edges: &true_rng(&points),
         stations,
+    };
+    outputs.stage(path, |temporary| write_rng(temporary, &picture))?;
+    Ok(())
+}
+
+/// Stages `path`: the landmarks `ids` at `positions`, labelled with their ids, and the edges of
+/// `rng` among them that `cut` keeps; `title` is followed by how many are drawn.
+pub fn stage_rng_over(
+    outputs: &mut OutputSet,
+    path: &Path,
+    title: String,
+    (ids, positions): (&[LandmarkId], &[(f64, f64)]),
+    rng: &RngEstimate,
+    cut: EdgeCut,
+    axes: Axes,
+) -> Result<()> {
+    let edges = cut.edges(ids, rng);
+    let labels: Vec<String> = ids.iter().map(|id| id.to_string()).collect();
+    let picture = RngPicture {
+        title: format!(
+            "{title}: {} landmarks, {}",
+            ids.len(),
+            cut.describe(edges.len(), rng.edges.len())
+        ),
+        landmarks: positions,
+        labels: &labels,
+        axes,
+        edges: &edges,
+        true_edges: &[],
+        stations: &[],
     };
     outputs.stage(path, |temporary| write_rng(temporary, &picture))?;
     Ok(())

@@ -15,7 +15,7 @@ use qrm_core::neighborhood::{estimate, true_rng};
 use qrm_core::simulation::{
     run, MonteCarlo, MonteCarloResult, Scenario, Sensor, Series, Statistic,
 };
-use qrm_plot::{write_panels, write_rng, Curve, Panel, RngPicture};
+use qrm_plot::{write_panels, write_rng, Axes, Curve, Panel, RngPicture};
 use rand::SeedableRng;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -392,7 +392,7 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
                 title: format!("RNG estimate after {} images", steps.len()),
                 landmarks: &landmarks,
                 labels: &labels,
-                metric: true,
+                axes: Axes::Metres,
                 edges: &edges,
                 true_edges: &true_edges,
                 stations: &stations,

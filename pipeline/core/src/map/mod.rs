@@ -8,6 +8,7 @@
 //!   observations, measured against what the map still allows (000 §IV, §VI-B);
 //! - [`Hypergraph::merge`]: fusing another map over the same landmark ids;
 //! - [`Network`]: constraint networks from outside, closed or narrowed to a minimal conflict;
+//! - [`Hypergraph::realize`]: positions under which every relation holds, for drawing;
 //! - JSON files (`docs/MAP_FORMAT.md`).
 
 mod closure;
@@ -18,6 +19,7 @@ mod kernel;
 mod network;
 mod observe;
 mod quad;
+mod realization;
 mod transaction;
 mod update;
 
@@ -25,6 +27,7 @@ pub use hypergraph::{Hypergraph, Triples};
 pub use json::{MapFormatError, MAX_LANDMARKS};
 pub use network::{Network, NetworkTextError};
 pub use observe::Sighting;
+pub use realization::{Realization, RealizeSettings};
 pub use update::{Contradiction, ContradictionStage, LandmarkId, Observation, UpdateReport};
 
 use crate::calculus::Calculus;
