@@ -222,6 +222,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         super::eval::check_survey(&contents, &survey)
             .with_context(|| format!("--truth {}; nothing was written", truth.display()))?;
     }
+    let checks_seconds = started.elapsed().as_secs_f64();
     let bars = if args.quiet {
         Bars::quiet()
     } else {
@@ -263,6 +264,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     let traverse = map_stations(&detected, mapper, &bars, |record, mapper| {
         record_station(&mut recorders, record, mapper, &survey, &calib)
     })?;
+    let writing = Instant::now();
 
     // Every output is staged and then renamed in one pass: an earlier run's files are all
     // replaced or none are (an interrupt before the pass leaves them as they were).
@@ -288,7 +290,9 @@ pub fn run(args: RunArgs) -> Result<()> {
     for recorder in recorders {
         outputs.adopt(recorder.finish()?);
     }
-    let summary = traverse.summary(detected.wall_seconds);
+    let mut summary = traverse.summary(detected.wall_seconds);
+    summary.wall_checks = checks_seconds;
+    summary.wall_outputs = writing.elapsed().as_secs_f64();
     stage(
         &mut outputs,
         &args.out.join("summary.json"),
@@ -305,14 +309,16 @@ pub fn run(args: RunArgs) -> Result<()> {
         let default = args.images.join("truth.json");
         default.exists().then_some(default)
     });
+    let scoring = Instant::now();
     let evaluation = match (truth, args.no_eval) {
         (Some(truth), false) => Some(super::eval::score_run_files(
             &args.out, &truth, &calib, &args.out, cut,
         )?),
         _ => None,
     };
+    let scoring_seconds = evaluation.as_ref().map(|_| scoring.elapsed().as_secs_f64());
     // Printed once every file is written: a reader that stops early ends the process.
-    print_summary(&summary, &args.out, started);
+    print_summary(&summary, &args.out, started, scoring_seconds);
     print_warnings(&bars.tally(), args.quiet);
     if let Some(evaluation) = &evaluation {
         super::eval::print_report(evaluation);
@@ -371,10 +377,13 @@ fn record_station(
     Ok(())
 }
 
-fn print_summary(summary: &RunSummary, out: &Path, started: Instant) {
+fn print_summary(summary: &RunSummary, out: &Path, started: Instant, scoring: Option<f64>) {
     println!("{summary}");
+    let scoring = scoring.map_or(String::new(), |s| {
+        format!(" (scoring against truth, after the outputs: {s:.2} s)")
+    });
     println!(
-        "total {:.2} s; outputs in {}",
+        "total {:.2} s{scoring}; outputs in {}",
         started.elapsed().as_secs_f64(),
         out.display()
     );

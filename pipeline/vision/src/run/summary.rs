@@ -43,6 +43,14 @@ pub struct RunSummary {
     /// Wall time of the parallel decode+detect stage and of the sequential mapping stage.
     pub wall_front_end: f64,
     pub wall_mapping: f64,
+    /// Wall time of writing the outputs (files, recordings, pictures), set by the writer;
+    /// with the checks before the work and the two stages above it accounts for the run.
+    #[serde(default)]
+    pub wall_outputs: f64,
+    /// Wall time of opening the survey and checking the inputs (the truth's fingerprints of
+    /// every image) before any work.
+    #[serde(default)]
+    pub wall_checks: f64,
 }
 
 impl RunSummary {
@@ -92,6 +100,8 @@ impl RunSummary {
             seconds_map: sum(|r| r.seconds.map),
             wall_front_end,
             wall_mapping,
+            wall_outputs: 0.0,
+            wall_checks: 0.0,
         }
     }
 }
@@ -141,14 +151,16 @@ impl fmt::Display for RunSummary {
         )?;
         write!(
             f,
-            "time: decode {:.2} s + detect {:.2} s (CPU, {:.2} s wall) | range {:.2} s, associate {:.2} s, map {:.2} s ({:.2} s wall)",
+            "time: checks {:.2} s | decode {:.2} s + detect {:.2} s (CPU, {:.2} s wall) | range {:.2} s, associate {:.2} s, map {:.2} s ({:.2} s wall) | outputs {:.2} s",
+            self.wall_checks,
             self.seconds_decode,
             self.seconds_detect,
             self.wall_front_end,
             self.seconds_range,
             self.seconds_associate,
             self.seconds_map,
-            self.wall_mapping
+            self.wall_mapping,
+            self.wall_outputs
         )
     }
 }
