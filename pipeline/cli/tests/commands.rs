@@ -1,5 +1,6 @@
 //! The `pipeline` binary end to end: one test binary, a module per group of commands.
 
+mod bad_input;
 mod navigate;
 mod run;
 mod subcommands;

@@ -40,13 +40,51 @@ pub enum SurveyError {
     Missing(PathBuf),
     #[error("{0} is not a directory")]
     NotDirectory(PathBuf),
-    #[error("cannot list {path}: {source}")]
+    // Not named `source`: the message holds it, and a chain printed with `{:#}` would repeat it.
+    #[error("cannot list {path}: {error}")]
     List {
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{0} holds no panoramas (.png, .jpg or .jpeg files)")]
     Empty(PathBuf),
+    /// Panoramas, but none that makes a station: right ones without their left partner, or
+    /// names that leave no station name.
+    #[error(
+        "{} holds no station: {}; a station is NAME_left with NAME_right, or NAME alone",
+        .directory.display(),
+        unused_files(.unpaired, .unnamed)
+    )]
+    NoStation {
+        directory: PathBuf,
+        unpaired: Vec<PathBuf>,
+        unnamed: Vec<PathBuf>,
+    },
+}
+
+/// Why each of these files makes no station, the first few named.
+fn unused_files(unpaired: &[PathBuf], unnamed: &[PathBuf]) -> String {
+    const NAMED: usize = 3;
+    let name = |p: &PathBuf| {
+        p.file_name()
+            .unwrap_or(p.as_os_str())
+            .to_string_lossy()
+            .into_owned()
+    };
+    let all: Vec<String> = unpaired
+        .iter()
+        .map(|p| format!("{} has no _left partner", name(p)))
+        .chain(
+            unnamed
+                .iter()
+                .map(|p| format!("{} leaves no station name", name(p))),
+        )
+        .collect();
+    let mut text = all[..all.len().min(NAMED)].join(", ");
+    if all.len() > NAMED {
+        text += &format!(" and {} more", all.len() - NAMED);
+    }
+    text
 }
 
 /// Why one image cannot be used.
@@ -78,9 +116,9 @@ impl Survey {
         if !directory.is_dir() {
             return Err(SurveyError::NotDirectory(directory.to_path_buf()));
         }
-        let list_error = |source| SurveyError::List {
+        let list_error = |error| SurveyError::List {
             path: directory.to_path_buf(),
-            source,
+            error,
         };
         let mut images = Vec::new();
         for entry in std::fs::read_dir(directory).map_err(list_error)? {
@@ -92,7 +130,14 @@ impl Survey {
         }
         let survey = Survey::from_files(directory, images);
         if survey.stations.is_empty() {
-            return Err(SurveyError::Empty(directory.to_path_buf()));
+            if survey.unpaired.is_empty() && survey.unnamed.is_empty() {
+                return Err(SurveyError::Empty(directory.to_path_buf()));
+            }
+            return Err(SurveyError::NoStation {
+                directory: directory.to_path_buf(),
+                unpaired: survey.unpaired,
+                unnamed: survey.unnamed,
+            });
         }
         Ok(survey)
     }

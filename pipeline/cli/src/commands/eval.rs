@@ -8,7 +8,7 @@ use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
 use qrm_core::map::{Hypergraph, LandmarkId};
 use qrm_core::neighborhood::estimate;
-use qrm_synth::dataset::Truth;
+use qrm_synth::dataset::{Truth, TRUTH_FORMAT, TRUTH_VERSION};
 use qrm_synth::evaluation::{self, Detectable, Evaluation, RunFiles};
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::DetectorSettings;
@@ -42,6 +42,8 @@ pub fn run(args: EvalArgs) -> Result<()> {
         .calib
         .clone()
         .unwrap_or_else(|| args.truth.with_file_name("calib.toml"));
+    // The truth first: a missing one is named, not the calibration missing beside it.
+    read_truth(&args.truth)?;
     let calib = Calibration::load(&calib_path)?;
     let cut = EdgeCut::new(args.all_edges);
     print_report(&score_run_files(&args.run, &args.truth, &calib, &out, cut)?);
@@ -56,9 +58,25 @@ fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
 }
 
 /// Reads and parses a truth file: `pipeline run` checks an explicit `--truth` before any
-/// work, so that a bad one fails with nothing written.
+/// work, so that a bad one fails with nothing written. Its `format` and `version` are those of
+/// datasets/README.md: another file of the same fields is not a truth file.
 pub fn read_truth(path: &Path) -> Result<Truth> {
-    read(path)
+    let truth: Truth = read(path)?;
+    if truth.format != TRUTH_FORMAT {
+        bail!(
+            "{}: \"format\" is {:?}, expected {TRUTH_FORMAT:?}: not a truth file",
+            path.display(),
+            truth.format
+        );
+    }
+    if truth.version != TRUTH_VERSION {
+        bail!(
+            "{}: truth file version {}, this reader knows version {TRUTH_VERSION}",
+            path.display(),
+            truth.version
+        );
+    }
+    Ok(truth)
 }
 
 /// Whether `truth` describes every image of `survey`, file by file (names and fingerprints:

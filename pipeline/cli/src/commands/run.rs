@@ -217,10 +217,28 @@ pub fn run(args: RunArgs) -> Result<()> {
         );
     }
     let calib = load_calibration(&args)?;
-    if let Some(truth) = args.truth.as_deref().filter(|_| !args.no_eval) {
-        let contents = super::eval::read_truth(truth).context("--truth; nothing was written")?;
-        super::eval::check_survey(&contents, &survey)
-            .with_context(|| format!("--truth {}; nothing was written", truth.display()))?;
+    // The truth, given or found in the image directory, is read before any work: a bad one
+    // would otherwise fail only once the run's outputs had replaced the earlier ones. A given
+    // one must also describe every image (a found one is checked image by image when scoring,
+    // so that a damaged panorama is skipped with a warning, as without truth).
+    let default_truth = args.images.join("truth.json");
+    let truth = match (&args.truth, args.no_eval) {
+        (_, true) => None,
+        (Some(truth), false) => Some((truth.clone(), true)),
+        (None, false) => default_truth.exists().then_some((default_truth, false)),
+    };
+    if let Some((path, given)) = &truth {
+        let what = if *given {
+            "--truth"
+        } else {
+            "the image directory's truth.json (--no-eval to map without it)"
+        };
+        let contents = super::eval::read_truth(path)
+            .with_context(|| format!("{what}; nothing was written"))?;
+        if *given {
+            super::eval::check_survey(&contents, &survey)
+                .with_context(|| format!("{what} {}; nothing was written", path.display()))?;
+        }
     }
     let checks_seconds = started.elapsed().as_secs_f64();
     let bars = if args.quiet {
@@ -255,7 +273,16 @@ pub fn run(args: RunArgs) -> Result<()> {
     settings.detector.channels = args.channels.into();
     let detected = match detect_survey(&survey, &calib, &settings.detector, &bars) {
         Ok(detected) => detected,
-        Err(e) => bail!("{e}; nothing was written"),
+        // Quiet runs print no warning lines: the reasons go with the error.
+        Err(e) => {
+            let reasons: Vec<String> = bars
+                .tally()
+                .into_iter()
+                .take(3)
+                .map(|(_, example)| example)
+                .collect();
+            bail!("{e} ({}); nothing was written", reasons.join("; "))
+        }
     };
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
@@ -305,16 +332,12 @@ pub fn run(args: RunArgs) -> Result<()> {
     outputs
         .commit()
         .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
-    let truth = args.truth.clone().or_else(|| {
-        let default = args.images.join("truth.json");
-        default.exists().then_some(default)
-    });
     let scoring = Instant::now();
-    let evaluation = match (truth, args.no_eval) {
-        (Some(truth), false) => Some(super::eval::score_run_files(
+    let evaluation = match truth {
+        Some((truth, _)) => Some(super::eval::score_run_files(
             &args.out, &truth, &calib, &args.out, cut,
         )?),
-        _ => None,
+        None => None,
     };
     let scoring_seconds = evaluation.as_ref().map(|_| scoring.elapsed().as_secs_f64());
     // Printed once every file is written: a reader that stops early ends the process.

@@ -36,8 +36,10 @@ struct TripleEntry {
 /// Why a JSON text is not a valid map of the expected calculus.
 #[derive(Debug, thiserror::Error)]
 pub enum MapFormatError {
+    // Not a `#[from]` source: the message holds it, and a chain printed with `{:#}` would
+    // repeat it.
     #[error("not a qrm map JSON document: {0}")]
-    Json(#[from] serde_json::Error),
+    Json(serde_json::Error),
     #[error("\"format\" is {0:?}, expected \"qrm-map\"")]
     Format(String),
     #[error("unsupported version {0}, this reader knows version 1")]
@@ -181,7 +183,7 @@ impl<C: Calculus> Hypergraph<C> {
 pub(super) type Entries = (Vec<LandmarkId>, Vec<([LandmarkId; 3], [RelationSet; 3])>);
 
 pub(super) fn parse_entries<C: Calculus>(text: &str) -> Result<Entries, MapFormatError> {
-    let file: MapFile = serde_json::from_str(text)?;
+    let file: MapFile = serde_json::from_str(text).map_err(MapFormatError::Json)?;
     if file.format != FORMAT {
         return Err(MapFormatError::Format(file.format));
     }

@@ -9,7 +9,8 @@ mod writer;
 
 pub use layout::{Counts, Layout, Preset};
 pub use truth::{
-    visible_rocks, ImageTruth, LumpTruth, RockTruth, StationTruth, Truth, VariantTruth, VisibleRock,
+    visible_rocks, ImageTruth, LumpTruth, RockTruth, StationTruth, Truth, VariantTruth,
+    VisibleRock, FORMAT as TRUTH_FORMAT, VERSION as TRUTH_VERSION,
 };
 pub use variant::Variant;
 pub use writer::{write_dataset, DatasetError, Request};

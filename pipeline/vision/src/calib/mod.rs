@@ -77,11 +77,9 @@ pub struct Stereo {
 /// A calibration that cannot be used, naming the file and the field.
 #[derive(Debug, Error)]
 pub enum CalibrationError {
-    #[error("cannot read calibration {path}: {source}")]
-    Read {
-        path: String,
-        source: std::io::Error,
-    },
+    // Not named `source`: the message holds it, and a chain printed with `{:#}` would repeat it.
+    #[error("cannot read calibration {path}: {error}")]
+    Read { path: String, error: std::io::Error },
     #[error("calibration {path}: {message}")]
     Syntax { path: String, message: String },
     #[error("calibration {path}: field `{field}` {problem}")]
@@ -103,9 +101,9 @@ const MAX_MAST_M: f64 = 20.0;
 impl Calibration {
     /// Reads and checks a calibration file.
     pub fn load(path: &Path) -> Result<Calibration, CalibrationError> {
-        let text = std::fs::read_to_string(path).map_err(|source| CalibrationError::Read {
+        let text = std::fs::read_to_string(path).map_err(|error| CalibrationError::Read {
             path: path.display().to_string(),
-            source,
+            error,
         })?;
         Calibration::parse(&text, &path.display().to_string())
     }
@@ -297,7 +295,32 @@ fn span_note(text: &str, span: Option<std::ops::Range<usize>>) -> String {
     let before = &text[..span.start.min(text.len())];
     let line = before.matches('\n').count() + 1;
     let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-    format!(" (line {line}, column {column})")
+    match field_at(text, span.start) {
+        Some(field) => format!(" (field `{field}`, line {line}, column {column})"),
+        None => format!(" (line {line}, column {column})"),
+    }
+}
+
+/// The field (`section.key`) whose value holds byte `at` of `text`, if `at` lies after the `=`
+/// of a `key = value` line: a value of the wrong type names the value only. (A missing field's
+/// span is its table, which starts at a key: no field is named for it.)
+fn field_at(text: &str, at: usize) -> Option<String> {
+    let start = text.get(..at)?.rfind('\n').map_or(0, |i| i + 1);
+    let (key, _) = text[start..at].split_once('=')?;
+    let key = key.trim();
+    if key.is_empty() || key.starts_with(['#', '[']) {
+        return None;
+    }
+    let section = text[..start]
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find(|l| l.starts_with('['))
+        .map(|l| l.trim_matches(['[', ']']).trim());
+    Some(match section {
+        Some(section) => format!("{section}.{key}"),
+        None => key.to_string(),
+    })
 }
 
 #[cfg(test)]
@@ -373,6 +396,25 @@ mod tests {
                 .unwrap_err()
                 .to_string();
             assert!(e.contains(field), "{to}: {e}");
+        }
+        // Values of the wrong type: the message names the field, not only the value.
+        for (from, to, field) in [
+            (
+                "focal_px = 652.0",
+                "focal_px = \"652\"",
+                "elevation.focal_px",
+            ),
+            ("width = 4096", "width = 4096.5", "image.width"),
+            (
+                "direction = \"clockwise\"",
+                "direction = 1",
+                "azimuth.direction",
+            ),
+        ] {
+            let e = Calibration::parse(&EXAMPLE.replace(from, to), "x.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(&format!("field `{field}`")), "{to}: {e}");
         }
         let unknown = format!("{EXAMPLE}\n[extra]\nfoo = 1\n");
         let e = Calibration::parse(&unknown, "x.toml")
