@@ -13,13 +13,18 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
 /// Temporary files created and neither committed nor removed yet.
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Held while an [`OutputSet`] renames its files, and by [`abandon_all`].
 static RENAMING: Mutex<()> = Mutex::new(());
+/// Held while a temporary file is created ([`create_file`]), and by [`abandon_all`]: a file
+/// is either created before the temporaries are removed (and removed with them) or never.
+static CREATING: Mutex<()> = Mutex::new(());
+/// Set by [`abandon_all`]: no temporary file is named after it.
+static ABANDONED: AtomicBool = AtomicBool::new(false);
 
 /// A lock that a panic elsewhere does not make unusable: the data are plain lists.
 fn lock<T>(mutex: &'static Mutex<T>) -> MutexGuard<'static, T> {
@@ -30,10 +35,15 @@ fn lock<T>(mutex: &'static Mutex<T>) -> MutexGuard<'static, T> {
 
 /// Removes every live temporary file of this process, after any [`OutputSet::commit`] under
 /// way has finished; for an interrupt handler that then ends the process. Returns how many
-/// files were removed. The renaming lock stays held until the process ends, so that no set is
-/// committed half-way after this.
+/// files were removed. The renaming and creating locks stay held until the process ends, so
+/// that no set is committed half-way and no temporary file is created after this (writers on
+/// other threads wait until the process ends). Every temporary file must be created with
+/// [`create_file`] for this to hold: a file created otherwise after its name was registered
+/// could outlive the sweep.
 pub fn abandon_all() -> usize {
+    ABANDONED.store(true, Ordering::SeqCst);
     std::mem::forget(lock(&RENAMING));
+    std::mem::forget(lock(&CREATING));
     let live = std::mem::take(&mut *lock(&LIVE));
     live.iter()
         .filter(|path| std::fs::remove_file(path).is_ok())
@@ -41,7 +51,23 @@ pub fn abandon_all() -> usize {
 }
 
 fn register(path: &Path) {
+    if ABANDONED.load(Ordering::SeqCst) {
+        // The process is ending: a new output would not be removed.
+        let _wait = lock(&CREATING);
+    }
     lock(&LIVE).push(path.to_path_buf());
+}
+
+/// Creates (or truncates) the temporary file `path` for writing; waits for the process to end
+/// instead if [`abandon_all`] has run.
+pub fn create_file(path: &Path) -> std::io::Result<std::fs::File> {
+    let _creating = lock(&CREATING);
+    std::fs::File::create(path)
+}
+
+/// Writes `bytes` to the temporary file `path` ([`create_file`]).
+pub fn write_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    create_file(path)?.write_all(bytes)
 }
 
 fn unregister(path: &Path) {
@@ -154,9 +180,7 @@ impl OutputSet {
 
     /// Stages `path` with content `bytes`.
     pub fn stage_bytes(&mut self, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-        self.stage(path, |temporary| {
-            std::fs::File::create(temporary)?.write_all(bytes)
-        })
+        self.stage(path, |temporary| write_file(temporary, bytes))
     }
 
     /// Adds a temporary file written elsewhere (a recording).
@@ -191,11 +215,7 @@ impl OutputSet {
 
 /// Writes `bytes` to `path` atomically.
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    write_via_temporary(
-        path,
-        |temporary| std::fs::File::create(temporary)?.write_all(bytes),
-        |e| e,
-    )
+    write_via_temporary(path, |temporary| write_file(temporary, bytes), |e| e)
 }
 
 /// `.<name>.<pid>-<n>.tmp.<extension>` next to `path`.

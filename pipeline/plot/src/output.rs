@@ -5,6 +5,8 @@
 
 use super::error::PlotError;
 use super::font;
+use image::codecs::png::PngEncoder;
+use image::{ExtendedColorType, ImageEncoder};
 use plotters::coord::Shift;
 use plotters::prelude::{BitMapBackend, DrawingArea, DrawingAreaErrorKind, DrawingBackend};
 use plotters::prelude::{IntoDrawingArea, SVGBackend};
@@ -73,11 +75,28 @@ fn render(
         path: path.to_path_buf(),
         reason,
     };
+    // Drawn in memory and written in one go through the interrupt-safe creation.
+    let write = |bytes: &[u8]| {
+        qrm_atomic_file::write_file(temporary, bytes).map_err(|source| PlotError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+    };
     match format {
         Format::Png => {
-            let root = BitMapBackend::new(temporary, figure.size()).into_drawing_area();
-            figure.draw(&root).map_err(|e| draw_error(e.to_string()))?;
-            root.present().map_err(|e| draw_error(e.to_string()))
+            let (width, height) = figure.size();
+            let mut pixels = vec![0u8; width as usize * height as usize * 3];
+            {
+                let root =
+                    BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
+                figure.draw(&root).map_err(|e| draw_error(e.to_string()))?;
+                root.present().map_err(|e| draw_error(e.to_string()))?;
+            }
+            let mut png = Vec::new();
+            PngEncoder::new(&mut png)
+                .write_image(&pixels, width, height, ExtendedColorType::Rgb8)
+                .map_err(|e| draw_error(e.to_string()))?;
+            write(&png)
         }
         Format::Svg => {
             let mut svg = String::new();
@@ -86,10 +105,7 @@ fn render(
                 figure.draw(&root).map_err(|e| draw_error(e.to_string()))?;
                 root.present().map_err(|e| draw_error(e.to_string()))?;
             }
-            std::fs::write(temporary, svg).map_err(|source| PlotError::Io {
-                path: path.to_path_buf(),
-                source,
-            })
+            write(svg.as_bytes())
         }
     }
 }

@@ -91,7 +91,7 @@ impl McapRecorder {
         let path = path.as_ref();
         let temporary = Temporary::beside(path);
         let start = || -> Result<_, Problem> {
-            let file = File::create(temporary.path())?;
+            let file = qrm_atomic_file::create_file(temporary.path())?;
             let mut writer = ::mcap::Writer::new(BufWriter::new(file))?;
             let mut channels = [0; 7];
             for (id, topic) in channels.iter_mut().zip(Topic::ALL) {
