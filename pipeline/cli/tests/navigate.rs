@@ -162,3 +162,83 @@ fn simulates_navigation_and_writes_its_outputs() {
         );
     }
 }
+
+/// `navigate locate` places panoramas against a run's map: every cell it claims holds against
+/// the truth (a certain cell is the true one; a possible set holds it, or names a rock not
+/// identified that may be nearer), and a run's files missing or a right-eye image are errors.
+#[test]
+fn locates_panoramas_against_a_run_soundly() {
+    const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../datasets/demo");
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let run = dir.join("run");
+    let o = pipeline(&[
+        "run",
+        "--images",
+        DEMO,
+        "--out",
+        run.to_str().unwrap(),
+        "--quiet",
+        "--panoramas",
+        "none",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let map = run.join("map.json");
+    let images: Vec<String> = (0..16)
+        .step_by(3)
+        .map(|i| format!("{DEMO}/station_{i:03}_left.png"))
+        .collect();
+    let answers = dir.join("answers.json");
+    let truth = format!("{DEMO}/truth.json");
+    let mut args = vec![
+        "navigate",
+        "locate",
+        "--map",
+        map.to_str().unwrap(),
+        "--image",
+    ];
+    args.extend(images.iter().map(String::as_str));
+    args.extend(["--truth", &truth, "--json", answers.to_str().unwrap()]);
+    let o = pipeline(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let answers: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&answers).unwrap()).unwrap();
+    let answers = answers.as_array().unwrap();
+    assert_eq!(answers.len(), images.len());
+    for answer in answers {
+        let verdict = answer["verdict"].as_str().unwrap();
+        assert!(
+            !["certain_wrong", "possible_misses"].contains(&verdict),
+            "{answer}"
+        );
+        assert!(
+            answer["identified"].as_array().unwrap().len() >= 3,
+            "{answer}"
+        );
+    }
+    assert!(stdout(&o).contains("over 6 panoramas"), "{}", stdout(&o));
+
+    std::fs::remove_file(run.join("landmarks.json")).unwrap();
+    let first = format!("{DEMO}/station_000_left.png");
+    let o = pipeline(&[
+        "navigate",
+        "locate",
+        "--map",
+        map.to_str().unwrap(),
+        "--image",
+        &first,
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("landmarks.json"));
+    let right = format!("{DEMO}/station_000_right.png");
+    let o = pipeline(&[
+        "navigate",
+        "locate",
+        "--map",
+        map.to_str().unwrap(),
+        "--image",
+        &right,
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("right-eye image"));
+}

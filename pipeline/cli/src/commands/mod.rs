@@ -1,6 +1,7 @@
 //! Subcommands of the `pipeline` binary beyond the calculus tools in `main.rs`.
 
 pub mod eval;
+pub mod locate;
 pub mod map;
 pub mod measure;
 pub mod navigate;

@@ -36,6 +36,14 @@ pub enum NavigateCommand {
         #[arg(long)]
         map: PathBuf,
     },
+    /// Which landmark's Voronoi cell a panorama was taken in, against the map of an earlier
+    /// `pipeline run` (its map.json, with landmarks.json and stations.json beside it): the
+    /// panorama's detections are associated with the run's landmarks (nothing is fused), and
+    /// the range order says which identified one is nearest, e.g. `navigate locate --map
+    /// run/map.json --image more/station_050_left.png`. Certain only when an identified
+    /// landmark is known nearer than every other detection (any unidentified rock may be a
+    /// landmark); otherwise the possible cells, or unknown.
+    Locate(super::locate::LocateArgs),
     /// Simulated navigation with an ideal sensor (bearings and range order of the landmarks,
     /// no rendering): random fields, random start/goal pairs, the leg follower of 000 §VII-B
     /// planning on the true RNG or on the RNG of a map after `--images` simulated panoramas.
@@ -135,6 +143,7 @@ pub fn run_command(command: NavigateCommand) -> Result<()> {
             }
         }
         NavigateCommand::Simulate(args) => simulate(&args),
+        NavigateCommand::Locate(args) => super::locate::locate(&args),
     }
 }
 

@@ -4,7 +4,7 @@
 pub mod front_end;
 mod mapper;
 mod record;
-mod selection;
+pub(crate) mod selection;
 mod summary;
 mod traverse;
 

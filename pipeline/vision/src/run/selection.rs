@@ -19,7 +19,7 @@ const MIN_COLUMNS: u32 = 3;
 const MAX_ASPECT: f64 = 1.5;
 
 /// The indices of the detections mapping can use: those [`exclusion`] keeps.
-pub(super) fn usable(station: &StationDetections, ranged: &[Ranged], width: u32) -> Vec<usize> {
+pub(crate) fn usable(station: &StationDetections, ranged: &[Ranged], width: u32) -> Vec<usize> {
     (0..ranged.len())
         .filter(|&i| exclusion(station, ranged, i, width).is_none())
         .collect()
@@ -60,7 +60,7 @@ fn stacked(d: &Detection) -> bool {
 
 /// The station as association sees it: the view of the `usable` detections, and the
 /// evidence of each.
-pub(super) fn station_evidence(
+pub(crate) fn station_evidence(
     station: &StationDetections,
     ranged: &[Ranged],
     usable: &[usize],
@@ -97,14 +97,17 @@ fn width_of(d: &Detection, ranged: &Ranged, model: &SensorModel) -> Option<Range
 /// A detection's rough position around the station, if its range is bounded well enough to
 /// place it: the middle of its range interval along its bearing.
 fn placed(r: &Ranged) -> Option<Placed> {
-    let [low, high] = r.fused.as_array();
+    placement(r.bearing.angle, r.bearing.uncertainty, r.fused.as_array())
+}
+
+/// The rough position of a rock at `bearing` (± `uncertainty`) and range in `[low, high]`
+/// metres: the middle of the interval along the bearing, with a radius covering the interval
+/// and the bearing error; none when the range is unbounded or wider than its middle.
+pub(crate) fn placement(bearing: f64, uncertainty: f64, [low, high]: [f64; 2]) -> Option<Placed> {
     let middle = 0.5 * (low + high);
     (high.is_finite() && high - low < middle).then(|| Placed {
-        point: [
-            middle * r.bearing.angle.cos(),
-            middle * r.bearing.angle.sin(),
-        ],
-        radius: 0.5 * (high - low) + high * r.bearing.uncertainty,
+        point: [middle * bearing.cos(), middle * bearing.sin()],
+        radius: 0.5 * (high - low) + high * uncertainty,
     })
 }
 

@@ -1,0 +1,199 @@
+//! Qualitative localization from one panorama (000 §VII-B step 4): which landmark's Voronoi
+//! cell the rover is in, against the map an earlier run built, from the panorama's range order
+//! alone. No position is estimated.
+//!
+//! The panorama's detections are ranged and associated with the run's landmarks as a mapping
+//! station would be (`crate::association::associate`: appearance proposes, registration
+//! against the run's stations anchors, the map's relations decide), but nothing is fused. The
+//! run's stations serve as the registration frames: each one's fused landmarks placed around
+//! it, rebuilt from `stations.json` and `landmarks.json`.
+//!
+//! The rover is in landmark `L`'s cell when `L` is the nearest landmark. Only an identified
+//! detection can name a landmark, and any detection not identified (held back, new, or not
+//! usable for mapping: a touching or partly hidden rock) may be a landmark too, so the claims
+//! are made over *every* detection of the panorama: *certain* when one identified detection
+//! is known nearer than every other detection; *possible* for the identified ones that no
+//! detection is known nearer than, with how many unidentified detections may be nearer still;
+//! *unknown* when no identified detection may be the nearest. A landmark hidden from view could
+//! be nearer than all of them, as for `qrm_core::navigation::cell_of`.
+
+use crate::association::{associate, AssociationSettings, Decision, Frame, Gallery};
+use crate::calib::Calibration;
+use crate::ranging::{self, SensorModel};
+use crate::run::selection::{placement, station_evidence, usable};
+use crate::run::{LandmarkRecord, StationDetections, StationRecord};
+use qrm_core::calculus::Calculus;
+use qrm_core::map::{Hypergraph, LandmarkId};
+use serde::Serialize;
+use std::collections::HashMap;
+
+/// The map of an earlier run, with what association needs to recognise its landmarks.
+pub struct KnownMap<C: Calculus> {
+    pub map: Hypergraph<C>,
+    gallery: Gallery,
+    frames: Vec<Frame>,
+}
+
+/// Which landmark's cell the panorama was taken in, as far as it tells.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(tag = "cell", rename_all = "snake_case")]
+pub enum Whereabouts {
+    /// Identified as landmark `landmark` and nearer than every other detection.
+    Certain { landmark: LandmarkId },
+    /// Each of `landmarks` may be the nearest; so may `unidentified` detections that are not
+    /// known to be farther.
+    Possible {
+        landmarks: Vec<LandmarkId>,
+        unidentified: usize,
+    },
+    /// No identified detection may be the nearest (or nothing was identified).
+    Unknown,
+}
+
+/// What one panorama told.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Location {
+    pub detections: usize,
+    /// Detections usable for association (`run::selection`).
+    pub usable: usize,
+    /// `(detection, landmark)` for each detection identified as a landmark of the map.
+    pub identified: Vec<(usize, LandmarkId)>,
+    /// `(detection, candidates)` for each detection that several landmarks may be.
+    pub ambiguous: Vec<(usize, Vec<LandmarkId>)>,
+    pub whereabouts: Whereabouts,
+}
+
+impl<C: Calculus> KnownMap<C> {
+    /// The map of a run with its landmarks' looks (`landmarks.json`) and, as registration
+    /// frames, every station's fused landmarks placed around it (`stations.json`).
+    pub fn from_run(
+        map: Hypergraph<C>,
+        landmarks: &[LandmarkRecord],
+        records: &[StationRecord],
+    ) -> KnownMap<C> {
+        let gallery = Gallery {
+            profiles: landmarks.iter().map(|l| l.profile.clone()).collect(),
+        };
+        let landmark_of: HashMap<(usize, usize), LandmarkId> = landmarks
+            .iter()
+            .flat_map(|l| l.sightings.iter().map(move |&s| (s, l.landmark)))
+            .collect();
+        let frames = records
+            .iter()
+            .map(|record| Frame {
+                accumulated: false,
+                landmarks: record
+                    .detections
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, d)| {
+                        let landmark = *landmark_of.get(&(record.index, i))?;
+                        let placed = placement(d.bearing, d.bearing_uncertainty, d.range.fused)?;
+                        Some((landmark, placed))
+                    })
+                    .collect(),
+            })
+            .filter(Frame::registrable)
+            .collect();
+        KnownMap {
+            map,
+            gallery,
+            frames,
+        }
+    }
+
+    /// Stations of the run that can serve as registration frames.
+    pub fn frames(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Places one station's detections against the map (see the module documentation).
+    pub fn locate(
+        &self,
+        station: &StationDetections,
+        calib: &Calibration,
+        sensor: &SensorModel,
+        settings: &AssociationSettings,
+    ) -> Location {
+        let ranged = ranging::observe(
+            &station.primary,
+            station.right.as_deref(),
+            station.eye,
+            calib,
+            sensor,
+        );
+        let usable = usable(station, &ranged, calib.image.width);
+        let mut identified = Vec::new();
+        let mut ambiguous = Vec::new();
+        if !usable.is_empty() {
+            let evidence = station_evidence(station, &ranged, &usable, sensor);
+            let decisions = associate(&self.map, &self.gallery, &self.frames, &evidence, settings);
+            for (&i, decision) in usable.iter().zip(decisions) {
+                match decision {
+                    Decision::Matched(landmark) => identified.push((i, landmark)),
+                    Decision::HeldBack(candidates) => ambiguous.push((i, candidates)),
+                    Decision::New => {}
+                }
+            }
+        }
+        // Over every detection: any of them may be a landmark.
+        let order = ranging::range_order(&ranged);
+        let nearest: Vec<usize> = (0..ranged.len())
+            .filter(|&i| !(0..ranged.len()).any(|j| order.is_nearer(j, i)))
+            .collect();
+        Location {
+            detections: ranged.len(),
+            usable: usable.len(),
+            whereabouts: whereabouts(&nearest, &identified),
+            identified,
+            ambiguous,
+        }
+    }
+}
+
+/// The cell claim from the detections no other is known nearer than (`nearest`) and the
+/// identified ones.
+fn whereabouts(nearest: &[usize], identified: &[(usize, LandmarkId)]) -> Whereabouts {
+    let landmark = |i: usize| identified.iter().find(|(d, _)| *d == i).map(|p| p.1);
+    let landmarks: Vec<LandmarkId> = nearest.iter().filter_map(|&i| landmark(i)).collect();
+    let unidentified = nearest.len() - landmarks.len();
+    match (landmarks.as_slice(), unidentified) {
+        ([], _) => Whereabouts::Unknown,
+        ([only], 0) => Whereabouts::Certain { landmark: *only },
+        _ => Whereabouts::Possible {
+            landmarks,
+            unidentified,
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{whereabouts, Whereabouts};
+
+    #[test]
+    fn a_cell_is_certain_only_when_the_lone_nearest_detection_is_identified() {
+        let identified = [(0, 7), (2, 9)];
+        assert_eq!(
+            whereabouts(&[0], &identified),
+            Whereabouts::Certain { landmark: 7 }
+        );
+        // Detection 1 may be nearer and may be any landmark.
+        assert_eq!(
+            whereabouts(&[0, 1], &identified),
+            Whereabouts::Possible {
+                landmarks: vec![7],
+                unidentified: 1
+            }
+        );
+        assert_eq!(
+            whereabouts(&[0, 2], &identified),
+            Whereabouts::Possible {
+                landmarks: vec![7, 9],
+                unidentified: 0
+            }
+        );
+        assert_eq!(whereabouts(&[1], &identified), Whereabouts::Unknown);
+        assert_eq!(whereabouts(&[], &identified), Whereabouts::Unknown);
+    }
+}
