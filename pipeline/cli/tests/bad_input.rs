@@ -1264,7 +1264,7 @@ fn map_cases() -> Vec<Case> {
 /// Command lines: unknown commands and options, values out of their sets or ranges, numbers
 /// that are not numbers, and outputs that would overwrite inputs.
 fn argument_cases() -> Vec<Case> {
-    let mut cases = vec![
+    let cases = vec![
         Case::new("no subcommand", "", &["Usage: pipeline <COMMAND>"]),
         Case::new(
             "an unknown subcommand",
@@ -1430,16 +1430,16 @@ fn argument_cases() -> Vec<Case> {
             &["invalid value 'many' for '--landmarks"],
         ),
     ];
-    #[cfg(not(feature = "rerun"))]
-    cases.push(
+    // Only a build without the rerun feature refuses --rrd.
+    let without_rerun = cfg!(not(feature = "rerun")).then(|| {
         Case::new(
             "--rrd in a build without rerun",
             "run --images {dir}/img --out {dir}/out --rrd",
             &["--rrd needs a build with the rerun feature"],
         )
-        .setup(demo),
-    );
-    cases
+        .setup(demo)
+    });
+    cases.into_iter().chain(without_rerun).collect()
 }
 
 #[test]

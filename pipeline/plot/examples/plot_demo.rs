@@ -131,6 +131,7 @@ fn main() -> anyhow::Result<()> {
             axes: Axes::Metres,
             edges: &edges,
             true_edges: &true_edges,
+            pruned: &[],
             stations: &stations,
         },
     )?;

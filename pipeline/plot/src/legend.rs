@@ -23,6 +23,8 @@ pub(super) enum Key {
     Line(RGBColor),
     /// A dashed line.
     Dashed(RGBColor),
+    /// A thin dotted line.
+    Dotted(RGBColor),
     /// A filled circle marker.
     Circle(RGBColor),
     /// An open circle marker.
@@ -185,6 +187,9 @@ fn draw_swatch<DB: DrawingBackend>(
         Key::Line(colour) => area.draw(&PathElement::new(line, colour.stroke_width(2))),
         Key::Dashed(colour) => {
             area.draw(&DashedPathElement::new(line, 6, 4, colour.stroke_width(2)))
+        }
+        Key::Dotted(colour) => {
+            area.draw(&DashedPathElement::new(line, 2, 4, colour.stroke_width(1)))
         }
         Key::Circle(colour) => area.draw(&Circle::new(middle, 6, colour.filled())),
         Key::Ring(colour) => area.draw(&Circle::new(middle, 6, colour.stroke_width(2))),

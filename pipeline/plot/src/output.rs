@@ -139,6 +139,7 @@ mod tests {
             axes: Axes::Metres,
             edges: &[(0, 1, 0.5)],
             true_edges: &[],
+            pruned: &[],
             stations: &[],
         };
         for name in ["fig.png", "fig.svg"] {
@@ -165,6 +166,7 @@ mod tests {
             axes: Axes::Layout,
             edges: &[],
             true_edges: &[],
+            pruned: &[],
             stations: &[],
         };
         write_rng(&path, &picture).unwrap();

@@ -48,6 +48,9 @@ pub struct RngPicture<'a> {
     pub edges: &'a [(usize, usize, f64)],
     /// Edges of the true RNG, drawn dashed in orange over the estimate (may be empty).
     pub true_edges: &'a [(usize, usize)],
+    /// Pairs the map rules out as edges (a third landmark certainly in their lune), drawn
+    /// thin, dotted and light under everything (may be empty).
+    pub pruned: &'a [(usize, usize)],
     /// Imaging points in order (green triangles); the last one is drawn red.
     pub stations: &'a [(f64, f64)],
 }
@@ -62,6 +65,7 @@ const LATEST_STATION: RGBColor = RGBColor(230, 0, 0);
 /// Drawn dashed over the estimate, so that the true edges among the estimated ones stand out
 /// (under it, every true edge the estimate keeps would be hidden).
 const TRUE_EDGE: RGBColor = RGBColor(255, 170, 0);
+const PRUNED: RGBColor = RGBColor(185, 185, 185);
 
 /// Writes `picture` to `path`; format by extension: `.png` (900×900 pixels) or `.svg`.
 ///
@@ -114,6 +118,9 @@ fn validate(picture: &RngPicture) -> Result<(), String> {
     }
     for &(i, j) in picture.true_edges {
         check("true RNG edge", i, j)?;
+    }
+    for &(i, j) in picture.pruned {
+        check("pruned pair", i, j)?;
     }
     let points = picture.landmarks.iter().chain(picture.stations).copied();
     let (x, y) = equal_aspect(points, (1, 1));
@@ -171,6 +178,12 @@ impl Figure for RngPicture<'_> {
             !self.true_edges.is_empty(),
             TRUE_EDGE,
         ));
+        if !self.pruned.is_empty() {
+            entries.push(Entry {
+                key: Key::Dotted(PRUNED),
+                label: "pair the map rules out".into(),
+            });
+        }
         if !self.stations.is_empty() {
             entries.push(Entry {
                 key: Key::Triangle(STATION),
@@ -223,6 +236,11 @@ impl Figure for RngPicture<'_> {
             .draw()?;
 
         let at = |i: usize| self.landmarks[i];
+        chart.draw_series(
+            self.pruned.iter().map(|&(i, j)| {
+                DashedPathElement::new([at(i), at(j)], 2, 4, PRUNED.stroke_width(1))
+            }),
+        )?;
         // Contested edges last, so that red is not hidden under black.
         let mut edges = self.edges.to_vec();
         edges.sort_by(|a, b| a.2.total_cmp(&b.2));
@@ -280,6 +298,7 @@ mod tests {
             axes: Axes::Metres,
             edges: &EDGES,
             true_edges: &TRUE_EDGES,
+            pruned: &[],
             stations: &STATIONS,
         }
     }
@@ -311,6 +330,7 @@ mod tests {
             axes: Axes::Layout,
             edges: &[],
             true_edges: &[],
+            pruned: &[],
             stations: &[],
         };
         write_rng(&path, &lone).unwrap();
@@ -328,6 +348,7 @@ mod tests {
                     landmarks: &[],
                     edges: &[],
                     true_edges: &[],
+                    pruned: &[],
                     ..picture()
                 },
                 "no landmarks",
@@ -337,6 +358,7 @@ mod tests {
                     landmarks: &nan,
                     edges: &[],
                     true_edges: &[],
+                    pruned: &[],
                     ..picture()
                 },
                 "landmark 1",
@@ -379,6 +401,7 @@ mod tests {
             (
                 RngPicture {
                     true_edges: &[(9, 0)],
+                    pruned: &[],
                     ..picture()
                 },
                 "true RNG edge (9, 0)",

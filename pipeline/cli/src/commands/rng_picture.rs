@@ -44,6 +44,23 @@ impl EdgeCut {
             .collect()
     }
 
+    /// With every edge drawn, the pairs the map rules out too (over positions in `ids`), so
+    /// that certain, uncertain and pruned pairs are all told apart; none with a cut.
+    fn pruned(&self, ids: &[LandmarkId], rng: &RngEstimate) -> Vec<(usize, usize)> {
+        if self.max_cost.is_some() {
+            return Vec::new();
+        }
+        let kept: std::collections::HashSet<(LandmarkId, LandmarkId)> = rng
+            .edges
+            .iter()
+            .map(|e| (e.a.min(e.b), e.a.max(e.b)))
+            .collect();
+        (0..ids.len())
+            .flat_map(|i| (i + 1..ids.len()).map(move |j| (i, j)))
+            .filter(|&(i, j)| !kept.contains(&(ids[i].min(ids[j]), ids[i].max(ids[j]))))
+            .collect()
+    }
+
     /// The title's account of what is drawn.
     fn describe(&self, shown: usize, possible: usize) -> String {
         match self.max_cost {
@@ -116,6 +133,7 @@ pub fn stage_rng_truth(
         axes: Axes::Metres,
         edges: &edges,
         true_edges: &true_rng(&points),
+        pruned: &cut.pruned(&ids, rng),
         stations,
     };
     outputs.stage(path, |temporary| write_rng(temporary, &picture))?;
@@ -146,6 +164,7 @@ pub fn stage_rng_over(
         axes,
         edges: &edges,
         true_edges: &[],
+        pruned: &cut.pruned(ids, rng),
         stations: &[],
     };
     outputs.stage(path, |temporary| write_rng(temporary, &picture))?;
@@ -190,5 +209,8 @@ mod tests {
             "1 of 3 edges (w ≤ 0.15)"
         );
         assert_eq!(EdgeCut::new(true).describe(3, 3), "3 possible edges");
+        // 1–5 is no edge: pruned, drawn only with every edge.
+        assert_eq!(EdgeCut::new(true).pruned(&ids, &rng), vec![(0, 2)]);
+        assert!(EdgeCut::new(false).pruned(&ids, &rng).is_empty());
     }
 }

@@ -395,6 +395,7 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
                 axes: Axes::Metres,
                 edges: &edges,
                 true_edges: &true_edges,
+                pruned: &[],
                 stations: &stations,
             },
         )?;
