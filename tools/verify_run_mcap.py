@@ -49,7 +49,7 @@ EXPECTED = {
     ),
 }
 DECISIONS = {"matched", "new", "held_back", "unused"}
-STAGES = {"decode", "detect", "range", "associate", "map"}
+STAGES = {"decode", "detect", "range", "associate", "map", "metrics"}
 NANOSECONDS = 1_000_000_000
 
 

@@ -7,6 +7,7 @@ use crate::detection::{detect, detect_right, Channels, DetectorSettings};
 use crate::ranging::PrimaryEye;
 use crate::run::StationDetections;
 use crate::survey::{is_jpeg, read_panorama, Station};
+use image::RgbImage;
 use std::path::Path;
 use std::time::Instant;
 
@@ -70,47 +71,73 @@ pub fn detect_station(
         _ => None,
     };
     let primary = primary.image;
-    let channels = settings
-        .channels
-        .resolve_file(&primary, right.is_some() && is_jpeg(&station.primary));
-    let settings = &DetectorSettings {
-        channels,
-        ..settings.clone()
-    };
-    if channels == Channels::Luminance && right.is_none() {
-        warnings.push(format!(
-            "station {}: detected by luminance (a grayscale panorama, or --channels luminance) \
-             without its right partner: rocks cannot be told from cast shadows without stereo, \
-             so its detections are not used",
-            station.name
-        ));
-    }
-    let start = Instant::now();
-    // Only the primary (left) panorama's blobs are separated by parallax: the right one's
-    // detections only serve the stereo cue, which separated parts do not take.
-    let primary_detections = detect(&primary, right.as_ref(), calib, settings);
-    let right_detections = right
-        .as_ref()
-        .map(|r| detect_right(r, Some(&primary), calib, settings));
-    detect_seconds += start.elapsed().as_secs_f64();
     let eye = if station.right.is_some() || is_left_image(&station.primary) {
         PrimaryEye::Left
     } else {
         PrimaryEye::Mono
     };
+    let start = Instant::now();
+    let mut detected = detect_panoramas(
+        &station.name,
+        &primary,
+        right.as_ref(),
+        eye,
+        right.is_some() && is_jpeg(&station.primary),
+        calib,
+        settings,
+    );
+    detect_seconds += start.elapsed().as_secs_f64();
+    warnings.append(&mut detected.warnings);
     FrontEndResult {
         station: Ok(StationDetections {
-            name: station.name.clone(),
             files,
             digests,
-            eye,
-            channels,
-            primary: primary_detections,
-            right: right_detections,
             warnings,
+            ..detected
         }),
         decode_seconds,
         detect_seconds,
+    }
+}
+
+/// Detects the rocks of one station's decoded panoramas (`right`: the stereo partner of a
+/// left `primary`); `jpeg`: the pair was JPEG-compressed, whose colour `Channels::Auto` does
+/// not trust. The result names no files.
+pub fn detect_panoramas(
+    name: &str,
+    primary: &RgbImage,
+    right: Option<&RgbImage>,
+    eye: PrimaryEye,
+    jpeg: bool,
+    calib: &Calibration,
+    settings: &DetectorSettings,
+) -> StationDetections {
+    let channels = settings.channels.resolve_file(primary, jpeg);
+    let settings = &DetectorSettings {
+        channels,
+        ..settings.clone()
+    };
+    let mut warnings = Vec::new();
+    if channels == Channels::Luminance && right.is_none() {
+        warnings.push(format!(
+            "station {name}: detected by luminance (a grayscale panorama, or --channels luminance) \
+             without its right partner: rocks cannot be told from cast shadows without stereo, \
+             so its detections are not used"
+        ));
+    }
+    // Only the primary (left) panorama's blobs are separated by parallax: the right one's
+    // detections only serve the stereo cue, which separated parts do not take.
+    let primary_detections = detect(primary, right, calib, settings);
+    let right_detections = right.map(|r| detect_right(r, Some(primary), calib, settings));
+    StationDetections {
+        name: name.to_string(),
+        files: Vec::new(),
+        digests: Vec::new(),
+        eye,
+        channels,
+        primary: primary_detections,
+        right: right_detections,
+        warnings,
     }
 }
 

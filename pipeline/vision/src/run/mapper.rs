@@ -159,7 +159,9 @@ impl<C: Calculus> Mapper<C> {
                 usable.len()
             ));
             record.fusion.resolved_held_back = self.retry_held_back(&mut record);
+            let start = Instant::now();
             record.metrics = self.refresh_metrics();
+            record.seconds.metrics = start.elapsed().as_secs_f64();
             return record;
         }
 
@@ -199,7 +201,9 @@ impl<C: Calculus> Mapper<C> {
         self.fuse_station(&mut record, associated, view);
         record.fusion.resolved_held_back = self.retry_held_back(&mut record);
         record.seconds.map = start.elapsed().as_secs_f64();
+        let start = Instant::now();
         record.metrics = self.refresh_metrics();
+        record.seconds.metrics = start.elapsed().as_secs_f64();
         record
     }
 

@@ -161,6 +161,17 @@ pub struct StageSeconds {
     pub range: f64,
     pub associate: f64,
     pub map: f64,
+    /// The map's metrics and RNG estimate after the station (Algorithm 2 over every pair).
+    #[serde(default)]
+    pub metrics: f64,
+    /// Handing the station to the recorders (run.mcap, run.rrd, with the RNG's layout): 0,
+    /// and not written, in the record the recorders get (it is timed around them).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub record: f64,
+}
+
+fn is_zero(seconds: &f64) -> bool {
+    *seconds == 0.0
 }
 
 /// `[low, high]` with an infinite `high` as `null`.

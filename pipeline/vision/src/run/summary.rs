@@ -40,6 +40,12 @@ pub struct RunSummary {
     pub seconds_range: f64,
     pub seconds_associate: f64,
     pub seconds_map: f64,
+    /// The map's metrics and RNG estimate after every station, and handing each station to
+    /// the recorders.
+    #[serde(default)]
+    pub seconds_metrics: f64,
+    #[serde(default)]
+    pub seconds_record: f64,
     /// Wall time of the parallel decode+detect stage and of the sequential mapping stage.
     pub wall_front_end: f64,
     pub wall_mapping: f64,
@@ -98,6 +104,8 @@ impl RunSummary {
             seconds_range: sum(|r| r.seconds.range),
             seconds_associate: sum(|r| r.seconds.associate),
             seconds_map: sum(|r| r.seconds.map),
+            seconds_metrics: sum(|r| r.seconds.metrics),
+            seconds_record: sum(|r| r.seconds.record),
             wall_front_end,
             wall_mapping,
             wall_outputs: 0.0,
@@ -151,7 +159,7 @@ impl fmt::Display for RunSummary {
         )?;
         write!(
             f,
-            "time: checks {:.2} s | decode {:.2} s + detect {:.2} s (CPU, {:.2} s wall) | range {:.2} s, associate {:.2} s, map {:.2} s ({:.2} s wall) | outputs {:.2} s",
+            "time: checks {:.2} s | decode {:.2} s + detect {:.2} s (CPU, {:.2} s wall) | range {:.2} s, associate {:.2} s, map {:.2} s, metrics and RNG {:.2} s, recording {:.2} s ({:.2} s wall) | outputs {:.2} s",
             self.wall_checks,
             self.seconds_decode,
             self.seconds_detect,
@@ -159,6 +167,8 @@ impl fmt::Display for RunSummary {
             self.seconds_range,
             self.seconds_associate,
             self.seconds_map,
+            self.seconds_metrics,
+            self.seconds_record,
             self.wall_mapping,
             self.wall_outputs
         )

@@ -152,7 +152,9 @@ pub fn map_stations<C: Calculus, E>(
         for warning in &record.warnings {
             progress.warn(warning);
         }
+        let recording = Instant::now();
         on_station(&record, &mapper)?;
+        record.seconds.record = recording.elapsed().as_secs_f64();
         records.push(record);
     }
     progress.end();
