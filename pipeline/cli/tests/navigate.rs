@@ -242,3 +242,81 @@ fn locates_panoramas_against_a_run_soundly() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("right-eye image"));
 }
+
+/// `navigate drive` runs closed-loop trips through the demo set's rendered world and writes
+/// its outputs; the navigator decides from the panoramas alone: with the truth that judges the
+/// trips scrambled (which rock each landmark is), every path is the same step for step.
+#[test]
+fn drives_through_the_rendered_world_without_seeing_it() {
+    const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../datasets/demo");
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let run = dir.join("run");
+    let o = pipeline(&[
+        "run",
+        "--images",
+        DEMO,
+        "--out",
+        run.to_str().unwrap(),
+        "--quiet",
+        "--panoramas",
+        "none",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let drive = |out: &str| {
+        let out = dir.join(out);
+        let o = pipeline(&[
+            "navigate",
+            "drive",
+            "--images",
+            DEMO,
+            "--run",
+            run.to_str().unwrap(),
+            "--trips",
+            "2",
+            "--max-steps",
+            "12",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        for file in ["trips.json", "summary.json", "drive.png"] {
+            assert!(out.join(file).is_file(), "{file}");
+        }
+        let trips: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("trips.json")).unwrap())
+                .unwrap();
+        trips
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| (t["path"].clone(), t["outcome"].clone(), t["route"].clone()))
+            .collect::<Vec<_>>()
+    };
+    let honest = drive("a");
+    assert_eq!(honest.len(), 2);
+    let eval_path = run.join("eval.json");
+    let mut eval: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&eval_path).unwrap()).unwrap();
+    let rocks = eval["landmark_rocks"].as_object_mut().unwrap();
+    let ids: Vec<serde_json::Value> = rocks.values().cloned().collect();
+    for (k, value) in rocks.values_mut().enumerate() {
+        *value = ids[(k + 1) % ids.len()].clone();
+    }
+    std::fs::write(&eval_path, eval.to_string()).unwrap();
+    assert_eq!(drive("b"), honest, "the judging truth changed a decision");
+
+    std::fs::remove_file(&eval_path).unwrap();
+    let o = pipeline(&[
+        "navigate",
+        "drive",
+        "--images",
+        DEMO,
+        "--run",
+        run.to_str().unwrap(),
+        "--out",
+        dir.join("c").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("eval.json"));
+}

@@ -147,10 +147,12 @@ impl FlowPicture {
             !self.true_edges.is_empty(),
             TRUE_EDGE,
         ));
-        entries.push(Entry {
-            key: Key::Line(ARROW),
-            label: "direction of motion".into(),
-        });
+        if !self.arrows.is_empty() {
+            entries.push(Entry {
+                key: Key::Line(ARROW),
+                label: "direction of motion".into(),
+            });
+        }
         if !self.trips.is_empty() {
             entries.push(Entry {
                 key: Key::Line(TRIP),

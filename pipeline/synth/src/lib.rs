@@ -11,6 +11,7 @@
 //! hash-map order, no thread-dependent reductions (rows are rendered in parallel, but each
 //! pixel depends only on its coordinates).
 
+pub mod closed_loop;
 pub mod dataset;
 pub mod evaluation;
 

@@ -24,6 +24,7 @@ use crate::run::selection::{placement, station_evidence, usable};
 use crate::run::{LandmarkRecord, StationDetections, StationRecord};
 use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, LandmarkId};
+use qrm_core::measurement::{RangeOrder, StationView};
 use serde::Serialize;
 use std::collections::HashMap;
 
@@ -61,6 +62,10 @@ pub struct Location {
     /// `(detection, candidates)` for each detection that several landmarks may be.
     pub ambiguous: Vec<(usize, Vec<LandmarkId>)>,
     pub whereabouts: Whereabouts,
+    /// The identified landmarks as the leg follower sees them (000 §VII-B): their ids, and
+    /// their bearings and range order by position in that list.
+    #[serde(skip)]
+    pub seen: (Vec<LandmarkId>, StationView),
 }
 
 impl<C: Calculus> KnownMap<C> {
@@ -141,10 +146,18 @@ impl<C: Calculus> KnownMap<C> {
         let nearest: Vec<usize> = (0..ranged.len())
             .filter(|&i| !(0..ranged.len()).any(|j| order.is_nearer(j, i)))
             .collect();
+        let indices: Vec<usize> = identified.iter().map(|p| p.0).collect();
+        let seen = StationView::new(
+            indices.iter().map(|&i| ranged[i].bearing).collect(),
+            RangeOrder::from_pairs(indices.len(), &order.restricted(&indices))
+                .expect("a sub-order of a strict order"),
+        )
+        .expect("bearings of usable detections are measurable");
         Location {
             detections: ranged.len(),
             usable: usable.len(),
             whereabouts: whereabouts(&nearest, &identified),
+            seen: (identified.iter().map(|p| p.1).collect(), seen),
             identified,
             ambiguous,
         }

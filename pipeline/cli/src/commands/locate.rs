@@ -154,7 +154,7 @@ pub fn locate(args: &LocateArgs) -> Result<()> {
 }
 
 /// The run's map, landmarks and stations, from `map` and the files beside it.
-fn load_run(map_path: &Path) -> Result<KnownMap<Edc>> {
+pub(super) fn load_run(map_path: &Path) -> Result<KnownMap<Edc>> {
     let text = read(map_path)?;
     let calculus = calculus_of(map_path, &text)?;
     if calculus != "EDC" {
@@ -227,6 +227,36 @@ fn station_of(path: &Path) -> Result<Station> {
     })
 }
 
+/// The rock each landmark of the run in `run` stands for, from its eval.json (the run scored
+/// against its truth).
+pub(super) fn read_landmark_rocks(run: &Path) -> Result<BTreeMap<LandmarkId, u32>> {
+    let eval_path = run.join("eval.json");
+    let text = std::fs::read_to_string(&eval_path).with_context(|| {
+        format!(
+            "cannot read {} (score the run against its truth: pipeline eval)",
+            eval_path.display()
+        )
+    })?;
+    let eval: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not JSON", eval_path.display()))?;
+    let by_name: BTreeMap<String, u32> = serde_json::from_value(eval["landmark_rocks"].clone())
+        .with_context(|| {
+            format!(
+                "{} has no landmark_rocks: score the run again with this version",
+                eval_path.display()
+            )
+        })?;
+    by_name
+        .into_iter()
+        .map(|(landmark, rock)| {
+            let landmark: LandmarkId = landmark
+                .parse()
+                .with_context(|| format!("{}: landmark {landmark:?}", eval_path.display()))?;
+            Ok((landmark, rock))
+        })
+        .collect()
+}
+
 /// The truth of the images and the rock each of the run's landmarks stands for.
 struct Scoring {
     truth: Truth,
@@ -236,20 +266,8 @@ struct Scoring {
 impl Scoring {
     fn new(map: &Path, truth_path: &Path) -> Result<Scoring> {
         let truth = super::eval::read_truth(truth_path)?;
-        let eval_path = map.with_file_name("eval.json");
-        let eval: serde_json::Value = read_json(&eval_path, map)?;
-        let landmark_rocks: BTreeMap<String, u32> =
-            serde_json::from_value(eval["landmark_rocks"].clone()).with_context(|| {
-                format!(
-                    "{} has no landmark_rocks: score the run again with this version",
-                    eval_path.display()
-                )
-            })?;
         let mut rocks = BTreeMap::new();
-        for (landmark, rock) in landmark_rocks {
-            let landmark: LandmarkId = landmark
-                .parse()
-                .with_context(|| format!("{}: landmark {landmark:?}", eval_path.display()))?;
+        for (landmark, rock) in read_landmark_rocks(map.parent().unwrap_or(Path::new(".")))? {
             let Some(r) = truth.rocks.get(rock as usize) else {
                 bail!(
                     "{} has no rock {rock}: not the world the run was scored in",

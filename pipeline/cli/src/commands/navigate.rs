@@ -44,6 +44,13 @@ pub enum NavigateCommand {
     /// landmark is known nearer than every other detection (any unidentified rock may be a
     /// landmark); otherwise the possible cells, or unknown.
     Locate(super::locate::LocateArgs),
+    /// Closed-loop trips through the rendered world of a synthetic dataset: at every step the
+    /// stereo panorama is rendered at the rover's pose, detected, associated with the map of a
+    /// `pipeline run` over that dataset, and the leg follower picks the heading; rocks are
+    /// obstacles (a hazard stop turns steps away from them). Writes trips.json, summary.json
+    /// and drive.png (000 Fig. 6 with the first three trips), e.g. `navigate drive --images
+    /// data/marsyard --run marsyard-run --trips 20`.
+    Drive(super::drive::DriveArgs),
     /// Simulated navigation with an ideal sensor (bearings and range order of the landmarks,
     /// no rendering): random fields, random start/goal pairs, the leg follower of 000 §VII-B
     /// planning on the true RNG or on the RNG of a map after `--images` simulated panoramas.
@@ -144,6 +151,7 @@ pub fn run_command(command: NavigateCommand) -> Result<()> {
         }
         NavigateCommand::Simulate(args) => simulate(&args),
         NavigateCommand::Locate(args) => super::locate::locate(&args),
+        NavigateCommand::Drive(args) => super::drive::run(&args),
     }
 }
 

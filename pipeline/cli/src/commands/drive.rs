@@ -1,0 +1,330 @@
+//! `pipeline navigate drive`: closed-loop trips through the rendered world of a synthetic
+//! dataset, navigating on the map a `pipeline run` built from it (`qrm_synth::closed_loop`,
+//! docs/NAVIGATION.md "Closed loop through rendered panoramas").
+
+use super::locate::{load_run, read_landmark_rocks};
+use super::output::write_atomic;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use qrm_core::geometry::Point;
+use qrm_core::map::LandmarkId;
+use qrm_core::navigation::{RouteCost, RouteGraph};
+use qrm_core::neighborhood::{estimate, true_rng};
+use qrm_plot::{write_flow, FlowPicture};
+use qrm_synth::closed_loop::{drive, Driving, Outcome, Terrain, Trip, CLEARANCE_M};
+use qrm_synth::dataset::{Counts, Preset};
+use qrm_synth::{Pose, World};
+use qrm_vision::calib::Calibration;
+use qrm_vision::run::RunSettings;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde_json::json;
+use std::collections::BTreeMap;
+use std::f64::consts::TAU;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct DriveArgs {
+    /// The synthetic dataset whose world the rover drives in (its truth.json names the preset
+    /// and seed the world is rendered from again, its calib.toml the camera).
+    #[arg(long)]
+    images: PathBuf,
+    /// The map's run: `pipeline run --images DATASET --out RUN` (map.json, landmarks.json,
+    /// stations.json, and eval.json, which says which rock each landmark is, for judging).
+    #[arg(long)]
+    run: PathBuf,
+    /// Trips: random starts clear of rocks, random goal landmarks (the first three share
+    /// their goal, for the figure).
+    #[arg(long, default_value_t = 20)]
+    trips: usize,
+    /// Step length, metres.
+    #[arg(long, default_value_t = 0.5)]
+    step: f64,
+    /// Steps before a trip is given up.
+    #[arg(long, default_value_t = 120)]
+    max_steps: usize,
+    /// Weight λ of an edge's RNG cost against one hop.
+    #[arg(long, default_value_t = 1.0)]
+    lambda: f64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output directory: trips.json, summary.json, drive.png.
+    #[arg(long, default_value = "drive")]
+    out: PathBuf,
+}
+
+pub fn run(args: &DriveArgs) -> Result<()> {
+    if !(args.step > 0.0 && args.step.is_finite()) {
+        bail!("--step {} must be a positive length", args.step);
+    }
+    if args.trips == 0 {
+        bail!("--trips must be at least 1");
+    }
+    let truth = super::eval::read_truth(&args.images.join("truth.json"))?;
+    if truth.variant.is_some() {
+        bail!(
+            "{}: a set rendered with variations (stress, scene or camera options) cannot be rendered again here; use a plain preset",
+            args.images.display()
+        );
+    }
+    let preset = [Preset::Marsyard, Preset::Random, Preset::SparseLarge]
+        .into_iter()
+        .find(|p| p.name() == truth.preset)
+        .with_context(|| format!("unknown preset {:?} in the truth file", truth.preset))?;
+    let calib = Calibration::load(&args.images.join("calib.toml"))?;
+    let layout = preset.layout(
+        truth.seed,
+        Counts {
+            rocks: Some(truth.rocks.len()),
+            stations: Some(truth.stations.len()),
+        },
+    );
+    let world = World::generate(truth.seed, &layout.rocks);
+    if world.rocks.iter().zip(&truth.rocks).any(|(r, t)| {
+        r.position
+            .distance(Point::new(t.position[0], t.position[1]))
+            > 1e-9
+    }) {
+        bail!(
+            "{}: the world rendered again from preset {} seed {} is not the one in its truth file",
+            args.images.display(),
+            truth.preset,
+            truth.seed
+        );
+    }
+    let known = load_run(&args.run.join("map.json"))?;
+    let landmark_rocks = read_landmark_rocks(&args.run)?;
+    let rng_estimate = estimate(&known.map).expect("EDC has a lune");
+    let graph = RouteGraph::new(known.map.landmarks(), &rng_estimate);
+    let goals: Vec<LandmarkId> = landmark_rocks.keys().copied().collect();
+    if goals.is_empty() {
+        bail!("the run's map has no landmark standing for a rock: nothing to drive to");
+    }
+    let terrain = Terrain {
+        world: &world,
+        calib: &calib,
+        landmark_rocks: &landmark_rocks,
+    };
+    let driving = Driving {
+        step_m: args.step,
+        max_steps: args.max_steps,
+        cost: RouteCost {
+            lambda: args.lambda,
+        },
+    };
+    let settings = RunSettings::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let (low, high) = extent(&world);
+    let bar = ProgressBar::new(args.trips as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} drive     [{bar:40}] {pos}/{len} trips ({elapsed}, eta {eta})",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    let mut trips = Vec::new();
+    let mut shared_goal = None;
+    for k in 0..args.trips {
+        let start = loop {
+            let p = Point::new(
+                rng.random_range(low.x..high.x),
+                rng.random_range(low.y..high.y),
+            );
+            let clear = world
+                .rocks
+                .iter()
+                .all(|r| r.position.distance(p) > world.contact_radius(r.id) + 2.0 * CLEARANCE_M);
+            if clear {
+                break Pose {
+                    position: p,
+                    heading: rng.random_range(0.0..TAU),
+                };
+            }
+        };
+        let goal = match (k < 3, shared_goal) {
+            (true, Some(goal)) => goal,
+            _ => goals[rng.random_range(0..goals.len())],
+        };
+        shared_goal.get_or_insert(goal);
+        trips.push(drive(
+            &terrain, &known, &graph, &settings, start, goal, &driving,
+        ));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let summary = summarize(&trips);
+    write_atomic(
+        &args.out.join("trips.json"),
+        (serde_json::to_string_pretty(&trips)? + "\n").as_bytes(),
+    )?;
+    write_atomic(
+        &args.out.join("summary.json"),
+        (serde_json::to_string_pretty(&summary)? + "\n").as_bytes(),
+    )?;
+    write_figure(args, &world, &landmark_rocks, &known, &trips)?;
+    println!(
+        "{} trips in {} (preset {}, seed {}), map of {} landmarks from {}:",
+        trips.len(),
+        args.images.display(),
+        truth.preset,
+        truth.seed,
+        known.map.len(),
+        args.run.display()
+    );
+    println!("{}", serde_json::to_string_pretty(&summary)?);
+    println!(
+        "wrote {}, {} and {}",
+        args.out.join("trips.json").display(),
+        args.out.join("summary.json").display(),
+        args.out.join("drive.png").display()
+    );
+    Ok(())
+}
+
+/// The box the rocks lie in, shrunk by a metre: where starts are drawn.
+fn extent(world: &World) -> (Point, Point) {
+    let xs = world.rocks.iter().map(|r| r.position.x);
+    let ys = world.rocks.iter().map(|r| r.position.y);
+    let (x0, x1) = (
+        xs.clone().fold(f64::INFINITY, f64::min),
+        xs.fold(f64::NEG_INFINITY, f64::max),
+    );
+    let (y0, y1) = (
+        ys.clone().fold(f64::INFINITY, f64::min),
+        ys.fold(f64::NEG_INFINITY, f64::max),
+    );
+    (
+        Point::new(x0 + 1.0, y0 + 1.0),
+        Point::new(x1 - 1.0, y1 - 1.0),
+    )
+}
+
+/// Success, collisions, steps, re-plans, path length and navigator time over the trips.
+fn summarize(trips: &[Trip]) -> serde_json::Value {
+    let n = trips.len() as f64;
+    let count = |f: &dyn Fn(&Trip) -> bool| trips.iter().filter(|t| f(t)).count();
+    let outcomes: BTreeMap<String, usize> = [
+        Outcome::Arrived,
+        Outcome::StartUnknown,
+        Outcome::NoRoute,
+        Outcome::Lost,
+        Outcome::OutOfSteps,
+    ]
+    .iter()
+    .map(|&o| {
+        (
+            serde_json::to_value(o)
+                .expect("serialises")
+                .as_str()
+                .unwrap_or("")
+                .to_string(),
+            count(&|t| t.outcome == o),
+        )
+    })
+    .collect();
+    let mut seconds: Vec<f64> = trips
+        .iter()
+        .flat_map(|t| t.navigator_seconds.clone())
+        .collect();
+    seconds.sort_by(f64::total_cmp);
+    let quantile = |v: &[f64], q: f64| {
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            v[((v.len() - 1) as f64 * q).round() as usize]
+        }
+    };
+    let mut ratios: Vec<f64> = trips
+        .iter()
+        .filter(|t| t.outcome == Outcome::Arrived && t.in_goal_cell && t.length_m > 0.0)
+        .map(|t| t.length_m / t.straight_m)
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    json!({
+        "trips": trips.len(),
+        "success": count(&|t| t.outcome == Outcome::Arrived && t.in_goal_cell) as f64 / n,
+        "arrived_but_not_in_goal_cell": count(&|t| t.outcome == Outcome::Arrived && !t.in_goal_cell),
+        "outcomes": outcomes,
+        "collisions": trips.iter().map(|t| t.collisions).sum::<usize>(),
+        "steps_avoided": trips.iter().map(|t| t.avoided).sum::<usize>(),
+        "replans": trips.iter().map(|t| t.replans).sum::<usize>(),
+        "steps": trips.iter().map(|t| t.navigator_seconds.len()).sum::<usize>(),
+        "median_length_over_straight": quantile(&ratios, 0.5),
+        "navigator_seconds_per_step": {
+            "median": quantile(&seconds, 0.5),
+            "p90": quantile(&seconds, 0.9),
+            "max": quantile(&seconds, 1.0),
+        },
+    })
+}
+
+/// drive.png: the map's landmarks at their rocks' positions, the RNG estimate, Voronoi
+/// borders, and the first three trips (one shared goal), as 000 Fig. 6.
+fn write_figure(
+    args: &DriveArgs,
+    world: &World,
+    landmark_rocks: &BTreeMap<LandmarkId, u32>,
+    known: &qrm_vision::localization::KnownMap<qrm_core::edc::Edc>,
+    trips: &[Trip],
+) -> Result<()> {
+    let ids: Vec<LandmarkId> = landmark_rocks.keys().copied().collect();
+    let raw: Vec<Point> = landmark_rocks
+        .values()
+        .map(|&r| world.rocks[r as usize].position)
+        .collect();
+    let shown: Vec<&Trip> = trips.iter().take(3).collect();
+    let all_x = raw
+        .iter()
+        .map(|p| p.x)
+        .chain(shown.iter().flat_map(|t| t.path.iter().map(|p| p[0])));
+    let all_y = raw
+        .iter()
+        .map(|p| p.y)
+        .chain(shown.iter().flat_map(|t| t.path.iter().map(|p| p[1])));
+    let (x0, x1) = (
+        all_x.clone().fold(f64::INFINITY, f64::min),
+        all_x.fold(f64::NEG_INFINITY, f64::max),
+    );
+    let (y0, y1) = (
+        all_y.clone().fold(f64::INFINITY, f64::min),
+        all_y.fold(f64::NEG_INFINITY, f64::max),
+    );
+    let shift = |x: f64, y: f64| (x - x0 + 1.0, y - y0 + 1.0);
+    let side = (x1 - x0).max(y1 - y0) + 2.0;
+    let rng = estimate(&known.map).expect("EDC has a lune");
+    let index = |l: LandmarkId| ids.iter().position(|&i| i == l);
+    let edges: Vec<(usize, usize, f64)> = rng
+        .edges
+        .iter()
+        .filter_map(|e| Some((index(e.a)?, index(e.b)?, e.cost)))
+        .collect();
+    let goal = shown
+        .first()
+        .and_then(|t| landmark_rocks.get(&t.goal))
+        .map(|&r| world.rocks[r as usize].position)
+        .unwrap_or(raw[0]);
+    let picture = FlowPicture {
+        title: format!(
+            "Closed loop through rendered panoramas: {} trips to landmark {}",
+            shown.len(),
+            shown.first().map_or(0, |t| t.goal)
+        ),
+        landmarks: raw.iter().map(|p| shift(p.x, p.y)).collect(),
+        edges,
+        true_edges: true_rng(&raw),
+        arrows: Vec::new(),
+        goal: shift(goal.x, goal.y),
+        trips: shown
+            .iter()
+            .map(|t| t.path.iter().map(|p| shift(p[0], p[1])).collect())
+            .collect(),
+        side,
+    };
+    write_flow(&args.out.join("drive.png"), &picture)?;
+    Ok(())
+}

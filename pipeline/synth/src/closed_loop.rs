@@ -1,0 +1,331 @@
+//! Closed-loop navigation through the rendered world (issue 15 item 3; 000 §VII-B): at every
+//! step the rover's stereo panorama is rendered at its true pose, the vision front end detects
+//! and ranges the rocks, they are associated with the map of an earlier run
+//! (`qrm_vision::localization`), and the leg follower (`qrm_core::navigation::LegFollower`)
+//! turns the identified landmarks' bearings and range order into a heading. The rover then
+//! drives one step that way.
+//!
+//! What the navigator decides from: the panorama only. It never sees the world: the route,
+//! the headings, arrival and re-planning come from the map and the images. Two things use the
+//! world, and neither decides where to go: the renderer, and the hazard stop that stands in for
+//! a rover's own hazard cameras. A step that would end within [`CLEARANCE_M`] of a rock's
+//! footprint is turned by 20° at a time, alternately either way, up to 100°, to the first
+//! clear one (a rover's local avoidance); if none is clear the rover stays put for that step.
+//! A path segment that crosses a footprint anyway counts as a collision.
+//!
+//! The follower's cell is that of the nearest *identified* landmark (`navigation::cell_of`
+//! over them; the first of the possible ones when the order cannot tell), as in the
+//! ideal-sensor study. The route is planned from the first panorama's cell. When the next
+//! landmark of the route is not identified in a panorama, the rover drives on its last
+//! bearing if it was seen in the last 3 steps (the rover keeps its heading, so bearings stay
+//! good); otherwise it re-plans from its cell: the cheapest of the 5 cheapest routes whose
+//! next landmark is in view (at most 5 re-plans), or the trip is lost.
+//!
+//! The rover keeps its heading (a holonomic rover, or one that turns back after each step):
+//! bearings are in the panorama's frame, and the step is taken in that frame. Success is
+//! judged against the truth only after the trip: the rover stopped in the goal landmark's
+//! Voronoi cell (the landmark whose rock is nearest to it).
+
+use crate::render::{render, Eye, Pose};
+use crate::world::World;
+use image::RgbImage;
+use qrm_core::edc::Edc;
+use qrm_core::geometry::Point;
+use qrm_core::map::LandmarkId;
+use qrm_core::navigation::{cell_of, Cell, Command, LegFollower, Route, RouteCost, RouteGraph};
+use qrm_vision::calib::Calibration;
+use qrm_vision::localization::KnownMap;
+use qrm_vision::ranging::PrimaryEye;
+use qrm_vision::run::front_end::detect_panoramas;
+use qrm_vision::run::RunSettings;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Nearest a step may end to a rock's footprint, metres (the rover's half-width and margin).
+pub const CLEARANCE_M: f64 = 0.3;
+/// Re-plans allowed when the next landmark of the route is lost from view.
+const REPLANS: usize = 5;
+/// Routes considered when re-planning.
+const ALTERNATIVES: usize = 5;
+/// Steps for which a landmark's last bearing is driven on while it is not identified.
+const MEMORY_STEPS: usize = 3;
+
+/// How the rover drives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Driving {
+    /// Length of one straight step, metres.
+    pub step_m: f64,
+    /// Steps before the trip is given up.
+    pub max_steps: usize,
+    pub cost: RouteCost,
+}
+
+/// How a trip ended, as the navigator saw it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// The follower says the rover is in the goal landmark's cell.
+    Arrived,
+    /// The first panorama identified no landmark that may be the nearest.
+    StartUnknown,
+    /// No route in the map's RNG from where the rover started to the goal.
+    NoRoute,
+    /// The route's next landmark was lost from view more often than re-planning allows.
+    Lost,
+    OutOfSteps,
+}
+
+/// One trip: what the navigator did, and (from the truth, afterwards) how well.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Trip {
+    pub start: [f64; 2],
+    pub goal: LandmarkId,
+    pub outcome: Outcome,
+    /// The first route planned.
+    pub route: Vec<LandmarkId>,
+    pub replans: usize,
+    /// Positions after every step, the start first.
+    pub path: Vec<[f64; 2]>,
+    /// Steps whose segment crossed a rock's footprint.
+    pub collisions: usize,
+    /// Steps the hazard stop turned or held.
+    pub avoided: usize,
+    /// Seconds of navigator compute per step: detection to heading, rendering excluded.
+    pub navigator_seconds: Vec<f64>,
+    /// Truth, afterwards: the rover stopped where the goal landmark's rock is the nearest of
+    /// the map's landmarks' rocks.
+    pub in_goal_cell: bool,
+    /// Path length, and the straight distance from the start to the goal's rock, metres.
+    pub length_m: f64,
+    pub straight_m: f64,
+}
+
+/// The rendered world the rover drives in.
+pub struct Terrain<'a> {
+    pub world: &'a World,
+    pub calib: &'a Calibration,
+    /// The rock each map landmark stands for (the truth, for judging trips only).
+    pub landmark_rocks: &'a BTreeMap<LandmarkId, u32>,
+}
+
+impl Terrain<'_> {
+    /// The stereo pair at `pose`.
+    fn panoramas(&self, pose: Pose) -> (RgbImage, RgbImage) {
+        let image = |eye| {
+            let r = render(self.world, self.calib, pose, eye);
+            RgbImage::from_raw(r.width, r.height, r.rgb).expect("a render fills its image")
+        };
+        (image(Eye::Left), image(Eye::Right))
+    }
+
+    /// Whether `p` lies within `margin` of a rock's footprint.
+    fn blocked(&self, p: Point, margin: f64) -> bool {
+        self.world
+            .rocks
+            .iter()
+            .any(|r| r.position.distance(p) < self.world.contact_radius(r.id) + margin)
+    }
+
+    /// Whether the segment `a`–`b` crosses a rock's footprint (sampled every 5 cm).
+    fn crosses(&self, a: Point, b: Point) -> bool {
+        let n = (a.distance(b) / 0.05).ceil().max(1.0) as usize;
+        (0..=n).any(|k| {
+            let t = k as f64 / n as f64;
+            self.blocked(
+                Point::new(a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)),
+                0.0,
+            )
+        })
+    }
+
+    /// The map landmark whose rock is nearest to `p`.
+    fn true_cell(&self, p: Point) -> Option<LandmarkId> {
+        self.landmark_rocks
+            .iter()
+            .map(|(&l, &r)| (l, self.world.rocks[r as usize].position.distance(p)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(l, _)| l)
+    }
+}
+
+/// Drives from `start` to the cell of landmark `goal` (see the module documentation).
+pub fn drive(
+    terrain: &Terrain,
+    known: &KnownMap<Edc>,
+    graph: &RouteGraph,
+    settings: &RunSettings,
+    start: Pose,
+    goal: LandmarkId,
+    driving: &Driving,
+) -> Trip {
+    let mut trip = Trip {
+        start: [start.position.x, start.position.y],
+        goal,
+        outcome: Outcome::OutOfSteps,
+        route: Vec::new(),
+        replans: 0,
+        path: vec![[start.position.x, start.position.y]],
+        collisions: 0,
+        avoided: 0,
+        navigator_seconds: Vec::new(),
+        in_goal_cell: false,
+        length_m: 0.0,
+        straight_m: terrain.landmark_rocks.get(&goal).map_or(f64::NAN, |&r| {
+            terrain.world.rocks[r as usize]
+                .position
+                .distance(start.position)
+        }),
+    };
+    let mut pose = start;
+    let mut follower: Option<LegFollower> = None;
+    // The last bearing each landmark was seen at, and how many steps ago: the rover keeps its
+    // heading, so a bearing stays good for a few steps while its landmark is not identified.
+    let mut last_seen: BTreeMap<LandmarkId, (f64, usize)> = BTreeMap::new();
+    for _ in 0..driving.max_steps {
+        let (left, right) = terrain.panoramas(pose);
+        let started = Instant::now();
+        let detections = detect_panoramas(
+            "rover",
+            &left,
+            Some(&right),
+            PrimaryEye::Left,
+            false,
+            terrain.calib,
+            &settings.detector,
+        );
+        let location = known.locate(
+            &detections,
+            terrain.calib,
+            &settings.sensor,
+            &settings.association,
+        );
+        let (visible, view) = &location.seen;
+        for seen in last_seen.values_mut() {
+            seen.1 += 1;
+        }
+        for (i, &l) in visible.iter().enumerate() {
+            last_seen.insert(l, (view.bearings[i].angle, 0));
+        }
+        // The cell the follower believes it is in: the nearest identified landmark.
+        let here = match cell_of(visible, &view.order) {
+            Some(Cell::Certain(l)) => Some(l),
+            Some(Cell::Possible(ls)) => ls.first().copied(),
+            None => None,
+        };
+        if follower.is_none() {
+            let Some(from) = here else {
+                trip.outcome = Outcome::StartUnknown;
+                break;
+            };
+            match graph.plan(from, goal, driving.cost) {
+                Ok(route) => {
+                    trip.route = route.landmarks.clone();
+                    follower = Some(LegFollower::new(&route));
+                }
+                Err(_) => {
+                    trip.outcome = Outcome::NoRoute;
+                    break;
+                }
+            }
+        }
+        let mut command = follower
+            .as_mut()
+            .expect("planned above")
+            .step(visible, view);
+        if let Command::TargetLost(target) = command {
+            command = match last_seen.get(&target) {
+                Some(&(bearing, ago)) if ago <= MEMORY_STEPS => Command::Toward {
+                    landmark: target,
+                    bearing,
+                },
+                _ => match replan(graph, here, goal, driving.cost, visible, trip.replans) {
+                    Some(route) => {
+                        trip.replans += 1;
+                        let mut next = LegFollower::new(&route);
+                        let command = next.step(visible, view);
+                        follower = Some(next);
+                        command
+                    }
+                    None => command,
+                },
+            };
+        }
+        trip.navigator_seconds.push(started.elapsed().as_secs_f64());
+        let bearing = match command {
+            Command::Arrived => {
+                trip.outcome = Outcome::Arrived;
+                break;
+            }
+            Command::Toward { bearing, .. } => bearing,
+            Command::TargetLost(_) => {
+                trip.outcome = Outcome::Lost;
+                break;
+            }
+        };
+        let next = step(terrain, pose, bearing, driving.step_m, &mut trip);
+        trip.length_m += pose.position.distance(next);
+        pose.position = next;
+        trip.path.push([next.x, next.y]);
+    }
+    trip.in_goal_cell = terrain.true_cell(pose.position) == Some(goal);
+    trip
+}
+
+/// A route from the rover's cell `here` to `goal` whose first landmark to drive to is in view
+/// (`visible`): the cheapest of the few cheapest routes; none once [`REPLANS`] are used.
+fn replan(
+    graph: &RouteGraph,
+    here: Option<LandmarkId>,
+    goal: LandmarkId,
+    cost: RouteCost,
+    visible: &[LandmarkId],
+    replans: usize,
+) -> Option<Route> {
+    if replans >= REPLANS {
+        return None;
+    }
+    graph
+        .alternatives(here?, goal, cost, ALTERNATIVES)
+        .ok()?
+        .into_iter()
+        .find(|r| {
+            let next = r.landmarks.get(1).unwrap_or(&r.landmarks[0]);
+            visible.contains(next)
+        })
+}
+
+/// One step from `pose` toward `bearing` (the panorama's frame), turned away from rocks by the
+/// hazard stop; records avoidance and collisions in `trip`.
+fn step(terrain: &Terrain, pose: Pose, bearing: f64, length: f64, trip: &mut Trip) -> Point {
+    let from = pose.position;
+    let toward = |turn: f64| {
+        let azimuth = pose.heading + bearing + turn;
+        Point::new(
+            from.x + length * azimuth.cos(),
+            from.y + length * azimuth.sin(),
+        )
+    };
+    let turns = [
+        0.0f64, 20.0, -20.0, 40.0, -40.0, 60.0, -60.0, 80.0, -80.0, 100.0, -100.0,
+    ];
+    let chosen = turns
+        .iter()
+        .map(|t| toward(t.to_radians()))
+        .position(|p| !terrain.blocked(p, CLEARANCE_M));
+    let next = match chosen {
+        Some(0) => toward(0.0),
+        Some(k) => {
+            trip.avoided += 1;
+            toward(turns[k].to_radians())
+        }
+        None => {
+            trip.avoided += 1;
+            from
+        }
+    };
+    if terrain.crosses(from, next) {
+        trip.collisions += 1;
+    }
+    next
+}
