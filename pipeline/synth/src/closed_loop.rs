@@ -17,9 +17,13 @@
 //! over them; the first of the possible ones when the order cannot tell), as in the
 //! ideal-sensor study. The route is planned from the first panorama's cell. When the next
 //! landmark of the route is not identified in a panorama, the rover drives on its last
-//! bearing if it was seen in the last 3 steps (the rover keeps its heading, so bearings stay
+//! bearing if it was seen in the last 6 steps (the rover keeps its heading, so bearings stay
 //! good); otherwise it re-plans from its cell: the cheapest of the 5 cheapest routes whose
-//! next landmark is in view (at most 5 re-plans), or the trip is lost.
+//! next landmark is in view, or, with none, a step on the goal's last bearing if it was ever
+//! seen (at most 5 re-plans); else the trip is lost. When the follower arrives (the goal is
+//! the nearest identified landmark) but a detection not identified may be nearer still, the
+//! rover closes in on the goal for up to 8 more steps until the panorama proves it the
+//! nearest of all.
 //!
 //! The rover keeps its heading (a holonomic rover, or one that turns back after each step):
 //! bearings are in the panorama's frame, and the step is taken in that frame. Success is
@@ -34,7 +38,7 @@ use qrm_core::geometry::Point;
 use qrm_core::map::LandmarkId;
 use qrm_core::navigation::{cell_of, Cell, Command, LegFollower, Route, RouteCost, RouteGraph};
 use qrm_vision::calib::Calibration;
-use qrm_vision::localization::KnownMap;
+use qrm_vision::localization::{KnownMap, Whereabouts};
 use qrm_vision::ranging::PrimaryEye;
 use qrm_vision::run::front_end::detect_panoramas;
 use qrm_vision::run::RunSettings;
@@ -49,7 +53,10 @@ const REPLANS: usize = 5;
 /// Routes considered when re-planning.
 const ALTERNATIVES: usize = 5;
 /// Steps for which a landmark's last bearing is driven on while it is not identified.
-const MEMORY_STEPS: usize = 3;
+const MEMORY_STEPS: usize = 6;
+/// Steps the rover closes in on the goal once it is the nearest identified landmark, until the
+/// panorama proves it nearer than every detection.
+const APPROACH_STEPS: usize = 8;
 
 /// How the rover drives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -182,6 +189,7 @@ pub fn drive(
     // The last bearing each landmark was seen at, and how many steps ago: the rover keeps its
     // heading, so a bearing stays good for a few steps while its landmark is not identified.
     let mut last_seen: BTreeMap<LandmarkId, (f64, usize)> = BTreeMap::new();
+    let mut approach = 0;
     for _ in 0..driving.max_steps {
         let (left, right) = terrain.panoramas(pose);
         let started = Instant::now();
@@ -247,9 +255,35 @@ pub fn drive(
                         follower = Some(next);
                         command
                     }
-                    None => command,
+                    // No route's next landmark in view: head for where the goal was last
+                    // seen, if ever, and look again from there.
+                    None => match last_seen.get(&goal) {
+                        Some(&(bearing, _)) if trip.replans < REPLANS => {
+                            trip.replans += 1;
+                            Command::Toward {
+                                landmark: goal,
+                                bearing,
+                            }
+                        }
+                        _ => command,
+                    },
                 },
             };
+        }
+        // The follower arrives when the goal is the nearest *identified* landmark; a rock not
+        // identified may still be nearer. Until the panorama proves the goal nearer than every
+        // detection, the rover closes in on the goal for a few more steps.
+        if command == Command::Arrived
+            && location.whereabouts != (Whereabouts::Certain { landmark: goal })
+            && approach < APPROACH_STEPS
+        {
+            if let Some(&(bearing, _)) = last_seen.get(&goal).filter(|s| s.1 <= MEMORY_STEPS) {
+                approach += 1;
+                command = Command::Toward {
+                    landmark: goal,
+                    bearing,
+                };
+            }
         }
         trip.navigator_seconds.push(started.elapsed().as_secs_f64());
         let bearing = match command {
