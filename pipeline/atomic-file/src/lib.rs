@@ -124,8 +124,10 @@ impl Temporary {
 
     /// Syncs the temporary file and renames it over the target.
     pub fn commit(self) -> std::io::Result<()> {
-        self.sync()?;
+        // Synced under the lock: after [`abandon_all`] the file is gone, and a failed sync
+        // would report an error while the process is ending on the interrupt.
         let _renaming = lock(&RENAMING);
+        self.sync()?;
         self.rename()
     }
 
@@ -196,10 +198,11 @@ impl OutputSet {
     /// Syncs every staged file, then renames each over its target and removes the stale
     /// files. An interrupt waits for the renames ([`abandon_all`]).
     pub fn commit(self) -> std::io::Result<()> {
+        // Synced under the lock, as in [`Temporary::commit`].
+        let _renaming = lock(&RENAMING);
         for temporary in &self.staged {
             temporary.sync()?;
         }
-        let _renaming = lock(&RENAMING);
         for temporary in self.staged {
             temporary.rename()?;
         }

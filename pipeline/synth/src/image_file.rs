@@ -3,6 +3,7 @@
 
 use super::render::Render;
 use image::codecs::jpeg::JpegEncoder;
+use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder};
 use std::io::BufWriter;
 use std::path::Path;
@@ -42,24 +43,16 @@ impl Render {
         } else {
             (&self.rgb, ExtendedColorType::Rgb8)
         };
+        // Created through the interrupt-safe creation: `path` is usually a temporary file.
+        let file = BufWriter::new(qrm_atomic_file::create_file(path)?);
         match encoding.jpeg_quality {
-            Some(quality) => {
-                let file = BufWriter::new(std::fs::File::create(path)?);
-                JpegEncoder::new_with_quality(file, quality).write_image(
-                    bytes,
-                    self.width,
-                    self.height,
-                    colour,
-                )
-            }
-            None => image::save_buffer_with_format(
-                path,
+            Some(quality) => JpegEncoder::new_with_quality(file, quality).write_image(
                 bytes,
                 self.width,
                 self.height,
                 colour,
-                image::ImageFormat::Png,
             ),
+            None => PngEncoder::new(file).write_image(bytes, self.width, self.height, colour),
         }
     }
 

@@ -14,8 +14,10 @@
 //! are made over *every* detection of the panorama: *certain* when one identified detection
 //! is known nearer than every other detection; *possible* for the identified ones that no
 //! detection is known nearer than, with how many unidentified detections may be nearer still;
-//! *unknown* when no identified detection may be the nearest. A landmark hidden from view could
-//! be nearer than all of them, as for `qrm_core::navigation::cell_of`.
+//! *unknown* when no identified detection may be the nearest. A certain cell also needs the
+//! identified landmarks, as the panorama measures them, to fit the map (a wrong identification
+//! would contradict it, as fusing it would when mapping); otherwise it is unknown. A landmark
+//! hidden from view could be nearer than all of them, as for `qrm_core::navigation::cell_of`.
 
 use crate::association::{associate, AssociationSettings, Decision, Frame, Gallery};
 use crate::calib::Calibration;
@@ -23,7 +25,7 @@ use crate::ranging::{self, SensorModel};
 use crate::run::selection::{placement, station_evidence, usable};
 use crate::run::{LandmarkRecord, StationDetections, StationRecord};
 use qrm_core::calculus::Calculus;
-use qrm_core::map::{Hypergraph, LandmarkId};
+use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
 use qrm_core::measurement::{RangeOrder, StationView};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -153,10 +155,14 @@ impl<C: Calculus> KnownMap<C> {
                 .expect("a sub-order of a strict order"),
         )
         .expect("bearings of usable detections are measurable");
+        let mut whereabouts = whereabouts(&nearest, &identified);
+        if matches!(whereabouts, Whereabouts::Certain { .. }) && !self.agrees(&identified, &seen) {
+            whereabouts = Whereabouts::Unknown;
+        }
         Location {
             detections: ranged.len(),
             usable: usable.len(),
-            whereabouts: whereabouts(&nearest, &identified),
+            whereabouts,
             seen: (identified.iter().map(|p| p.1).collect(), seen),
             identified,
             ambiguous,
@@ -164,12 +170,35 @@ impl<C: Calculus> KnownMap<C> {
     }
 }
 
+impl<C: Calculus> KnownMap<C> {
+    /// Whether the identified landmarks, measured as `seen` shows them, fit the map: a
+    /// certain cell rests on its identification, and a wrong one (a look-alike registered by
+    /// chance) would contradict the map as it would if fused when mapping.
+    fn agrees(&self, identified: &[(usize, LandmarkId)], seen: &StationView) -> bool {
+        let mut sightings: Vec<Sighting> = Vec::new();
+        for (position, &(_, landmark)) in identified.iter().enumerate() {
+            if !sightings.iter().any(|s| s.landmark == landmark) {
+                sightings.push(Sighting::new(position, landmark));
+            }
+        }
+        let observations = self.map.observations(seen, &sightings);
+        let mut trial = self.map.clone();
+        trial.fuse(&observations).is_ok()
+    }
+}
+
 /// The cell claim from the detections no other is known nearer than (`nearest`) and the
 /// identified ones.
 fn whereabouts(nearest: &[usize], identified: &[(usize, LandmarkId)]) -> Whereabouts {
     let landmark = |i: usize| identified.iter().find(|(d, _)| *d == i).map(|p| p.1);
-    let landmarks: Vec<LandmarkId> = nearest.iter().filter_map(|&i| landmark(i)).collect();
-    let unidentified = nearest.len() - landmarks.len();
+    let unidentified = nearest.iter().filter(|&&i| landmark(i).is_none()).count();
+    let mut landmarks: Vec<LandmarkId> = Vec::new();
+    // Two detections identified as one landmark (pieces of one rock) name it once.
+    for l in nearest.iter().filter_map(|&i| landmark(i)) {
+        if !landmarks.contains(&l) {
+            landmarks.push(l);
+        }
+    }
     match (landmarks.as_slice(), unidentified) {
         ([], _) => Whereabouts::Unknown,
         ([only], 0) => Whereabouts::Certain { landmark: *only },
@@ -207,6 +236,11 @@ mod tests {
             }
         );
         assert_eq!(whereabouts(&[1], &identified), Whereabouts::Unknown);
+        // Two pieces identified as one landmark: still one cell.
+        assert_eq!(
+            whereabouts(&[0, 3], &[(0, 7), (3, 7)]),
+            Whereabouts::Certain { landmark: 7 }
+        );
         assert_eq!(whereabouts(&[], &identified), Whereabouts::Unknown);
     }
 }

@@ -3,10 +3,10 @@
 //! docs/NAVIGATION.md "Closed loop through rendered panoramas").
 
 use super::locate::{load_run, read_landmark_rocks};
-use super::output::write_atomic;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use qrm_atomic_file::OutputSet;
 use qrm_core::geometry::Point;
 use qrm_core::map::LandmarkId;
 use qrm_core::navigation::{RouteCost, RouteGraph};
@@ -61,6 +61,9 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     if args.trips == 0 {
         bail!("--trips must be at least 1");
     }
+    if !(args.lambda >= 0.0 && args.lambda.is_finite()) {
+        bail!("--lambda {} must be a finite number ≥ 0", args.lambda);
+    }
     let truth = super::eval::read_truth(&args.images.join("truth.json"))?;
     if truth.variant.is_some() {
         bail!(
@@ -95,6 +98,16 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     }
     let known = load_run(&args.run.join("map.json"))?;
     let landmark_rocks = read_landmark_rocks(&args.run)?;
+    if let Some((l, r)) = landmark_rocks
+        .iter()
+        .find(|(_, &r)| r as usize >= world.rocks.len())
+    {
+        bail!(
+            "{}: landmark {l} stands for rock {r}, which {} does not have: not the run of this dataset",
+            args.run.join("eval.json").display(),
+            args.images.display()
+        );
+    }
     let rng_estimate = estimate(&known.map).expect("EDC has a lune");
     let graph = RouteGraph::new(known.map.landmarks(), &rng_estimate);
     let goals: Vec<LandmarkId> = landmark_rocks.keys().copied().collect();
@@ -116,6 +129,12 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     let settings = RunSettings::default();
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let (low, high) = extent(&world);
+    if !(low.x < high.x && low.y < high.y) {
+        bail!(
+            "{}: the rocks span too little ground to draw starts among them",
+            args.images.display()
+        );
+    }
     let bar = ProgressBar::new(args.trips as u64);
     bar.set_style(
         ProgressStyle::with_template(
@@ -127,7 +146,15 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     let mut trips = Vec::new();
     let mut shared_goal = None;
     for k in 0..args.trips {
+        let mut attempts = 0;
         let start = loop {
+            attempts += 1;
+            if attempts > 10_000 {
+                bail!(
+                    "{}: no start point clear of the rocks in 10 000 draws",
+                    args.images.display()
+                );
+            }
             let p = Point::new(
                 rng.random_range(low.x..high.x),
                 rng.random_range(low.y..high.y),
@@ -158,15 +185,24 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let summary = summarize(&trips);
-    write_atomic(
-        &args.out.join("trips.json"),
-        (serde_json::to_string_pretty(&trips)? + "\n").as_bytes(),
-    )?;
-    write_atomic(
-        &args.out.join("summary.json"),
-        (serde_json::to_string_pretty(&summary)? + "\n").as_bytes(),
-    )?;
-    write_figure(args, &world, &landmark_rocks, &known, &trips)?;
+    // The three files replace an earlier drive's together.
+    let mut outputs = OutputSet::new();
+    for (name, json) in [
+        ("trips.json", serde_json::to_string_pretty(&trips)?),
+        ("summary.json", serde_json::to_string_pretty(&summary)?),
+    ] {
+        let path = args.out.join(name);
+        outputs
+            .stage_bytes(&path, (json + "\n").as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let picture = figure(&world, &landmark_rocks, &known, &trips);
+    outputs.stage(&args.out.join("drive.png"), |temporary| {
+        write_flow(temporary, &picture)
+    })?;
+    outputs
+        .commit()
+        .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
     println!(
         "{} trips in {} (preset {}, seed {}), map of {} landmarks from {}:",
         trips.len(),
@@ -265,13 +301,12 @@ fn summarize(trips: &[Trip]) -> serde_json::Value {
 
 /// drive.png: the map's landmarks at their rocks' positions, the RNG estimate, Voronoi
 /// borders, and the first three trips (one shared goal), as 000 Fig. 6.
-fn write_figure(
-    args: &DriveArgs,
+fn figure(
     world: &World,
     landmark_rocks: &BTreeMap<LandmarkId, u32>,
     known: &qrm_vision::localization::KnownMap<qrm_core::edc::Edc>,
     trips: &[Trip],
-) -> Result<()> {
+) -> FlowPicture {
     let ids: Vec<LandmarkId> = landmark_rocks.keys().copied().collect();
     let raw: Vec<Point> = landmark_rocks
         .values()
@@ -308,7 +343,7 @@ fn write_figure(
         .and_then(|t| landmark_rocks.get(&t.goal))
         .map(|&r| world.rocks[r as usize].position)
         .unwrap_or(raw[0]);
-    let picture = FlowPicture {
+    FlowPicture {
         title: format!(
             "Closed loop through rendered panoramas: {} trips to landmark {}",
             shown.len(),
@@ -324,7 +359,5 @@ fn write_figure(
             .map(|t| t.path.iter().map(|p| shift(p[0], p[1])).collect())
             .collect(),
         side,
-    };
-    write_flow(&args.out.join("drive.png"), &picture)?;
-    Ok(())
+    }
 }

@@ -67,7 +67,8 @@ enum Verdict {
     CertainWrong,
     /// The true cell is among the possible landmarks.
     PossibleHolds,
-    /// It is not, but a detection not identified may be nearer: the claim still holds.
+    /// It is not, but a detection not identified may be nearer: the claim leaves room for
+    /// the true cell (whether that detection is the true cell's rock is not checked).
     PossibleUnidentified,
     /// It is not, and nothing else may be nearer: a wrong claim.
     PossibleMisses,
@@ -133,7 +134,7 @@ pub fn locate(args: &LocateArgs) -> Result<()> {
     if scoring.is_some() {
         let count = |v: Verdict| answers.iter().filter(|a| a.verdict == Some(v)).count();
         println!(
-            "over {} panoramas: certain {} right, {} wrong; possible {} naming the true cell, {} through a rock not identified, {} wrong; unknown {}",
+            "over {} panoramas: certain {} right, {} wrong; possible {} naming the true cell, {} leaving room for it through a detection not identified, {} wrong; unknown {}",
             answers.len(),
             count(Verdict::CertainRight),
             count(Verdict::CertainWrong),
@@ -289,13 +290,29 @@ impl Scoring {
         let Some(entry) = self.truth.images.iter().find(|i| i.file == file) else {
             bail!("the truth file has no image {file}");
         };
-        let at = self.truth.stations[entry.station].position;
+        let Some(station) = self.truth.stations.get(entry.station) else {
+            bail!(
+                "the truth file's image {file} names station {}, which it does not list",
+                entry.station
+            );
+        };
+        let at = station.position;
         let distance = |p: &[f64; 2]| (p[0] - at[0]).hypot(p[1] - at[1]);
         Ok(self
             .rocks
             .iter()
             .min_by(|a, b| distance(a.1).total_cmp(&distance(b.1)))
             .map(|(&l, _)| l))
+    }
+}
+
+impl Verdict {
+    /// The verdict as written in the JSON.
+    fn name(self) -> String {
+        serde_json::to_value(self)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default()
     }
 }
 
@@ -341,8 +358,8 @@ fn describe(
         Whereabouts::Unknown => "cell unknown: the nearest rock is not identified".into(),
     };
     let scored = match (verdict, truth) {
-        (Some(v), Some(t)) => format!(" [truth: landmark {t}; {v:?}]"),
-        (Some(v), None) => format!(" [{v:?}]"),
+        (Some(v), Some(t)) => format!(" [truth: landmark {t}; {}]", v.name()),
+        (Some(v), None) => format!(" [{}]", v.name()),
         _ => String::new(),
     };
     format!(

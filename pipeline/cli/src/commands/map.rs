@@ -57,13 +57,13 @@ pub enum MapCommand {
         #[arg(long)]
         picture: Option<PathBuf>,
         /// Seed of the search: the same seed gives the same layout.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = RealizeSettings::default().seed)]
         seed: u64,
         /// Rounds in which every landmark is offered one move, per start.
-        #[arg(long, default_value_t = 2000)]
+        #[arg(long, default_value_t = RealizeSettings::default().sweeps)]
         sweeps: usize,
         /// Fresh random starts tried until one satisfies every relation.
-        #[arg(long, default_value_t = 4)]
+        #[arg(long, default_value_t = RealizeSettings::default().restarts)]
         restarts: usize,
         /// Draw every possible RNG edge, not only those of cost w ≤ 0.15.
         #[arg(long)]
@@ -147,6 +147,24 @@ pub fn run_command(command: MapCommand) -> Result<()> {
                 restarts,
             };
             let picture = picture.unwrap_or_else(|| out.with_extension("png"));
+            // Checked before the search, which can take seconds.
+            if picture == out {
+                bail!(
+                    "--picture {} is the --out file: give the layout a .json name",
+                    picture.display()
+                );
+            }
+            let extension = |p: &Path| {
+                p.extension()
+                    .map(|e| e.to_string_lossy().to_ascii_lowercase())
+                    .unwrap_or_default()
+            };
+            if !["png", "svg"].contains(&extension(&picture).as_str()) {
+                bail!(
+                    "--picture {}: a picture is written as .png or .svg",
+                    picture.display()
+                );
+            }
             let cut = EdgeCut::new(all_edges);
             let exact = match calculus_of(&file, &text)?.as_str() {
                 "EDC" => realize(&load::<Edc>(&file, &text)?, &settings, &out, &picture, cut)?,
@@ -279,7 +297,7 @@ fn realize<C: Calculus>(
             (serde_json::to_string_pretty(&json)? + "\n").as_bytes(),
         )
         .with_context(|| format!("cannot write {}", out.display()))?;
-    let rng = estimate(map).unwrap_or_default();
+    let rng = estimate(map);
     let positions: Vec<(f64, f64)> = found.positions.iter().map(|p| (p.x, p.y)).collect();
     let title = if found.is_exact() {
         format!("One realization of the {} map", C::NAME)
@@ -291,7 +309,7 @@ fn realize<C: Calculus>(
         picture,
         title,
         (&found.landmarks, &positions),
-        &rng,
+        rng.as_ref(),
         cut,
         Axes::Realization,
     )?;

@@ -27,7 +27,8 @@ pub enum PanoramaSize {
     /// At the panorama's own size.
     Full,
     /// Not written (the contact sheet still is).
-    None,
+    #[value(name = "none")]
+    Off,
 }
 
 /// The widest annotated panorama written by default, pixels.
@@ -53,7 +54,7 @@ pub fn stage_pictures(
     size: PanoramaSize,
 ) -> Result<Vec<String>> {
     let directory = out.join("panoramas");
-    if size != PanoramaSize::None {
+    if size != PanoramaSize::Off {
         std::fs::create_dir_all(&directory)
             .with_context(|| format!("cannot create {}", directory.display()))?;
     }
@@ -198,7 +199,7 @@ fn station_pictures(
         })
         .collect();
     let panorama = match size {
-        PanoramaSize::None => None,
+        PanoramaSize::Off => None,
         PanoramaSize::Full | PanoramaSize::Reduced => {
             let path = directory.join(format!("{}.png", record.station));
             Some(annotate(record, &image, size, fused, &path)?)

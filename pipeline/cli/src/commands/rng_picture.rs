@@ -95,7 +95,7 @@ pub fn stage_rng_png(
         path,
         format!("RNG after {stations} stations"),
         (ids, &positions),
-        rng,
+        Some(rng),
         cut,
         Axes::Layout,
     )
@@ -141,30 +141,34 @@ pub fn stage_rng_truth(
 }
 
 /// Stages `path`: the landmarks `ids` at `positions`, labelled with their ids, and the edges of
-/// `rng` among them that `cut` keeps; `title` is followed by how many are drawn.
+/// `rng` among them that `cut` keeps (none without an estimate: FDC has no lune); `title` is
+/// followed by how many are drawn.
 pub fn stage_rng_over(
     outputs: &mut OutputSet,
     path: &Path,
     title: String,
     (ids, positions): (&[LandmarkId], &[(f64, f64)]),
-    rng: &RngEstimate,
+    rng: Option<&RngEstimate>,
     cut: EdgeCut,
     axes: Axes,
 ) -> Result<()> {
-    let edges = cut.edges(ids, rng);
+    let (edges, pruned, described) = match rng {
+        Some(rng) => {
+            let edges = cut.edges(ids, rng);
+            let described = cut.describe(edges.len(), rng.edges.len());
+            (edges, cut.pruned(ids, rng), described)
+        }
+        None => (Vec::new(), Vec::new(), "no RNG estimate".to_string()),
+    };
     let labels: Vec<String> = ids.iter().map(|id| id.to_string()).collect();
     let picture = RngPicture {
-        title: format!(
-            "{title}: {} landmarks, {}",
-            ids.len(),
-            cut.describe(edges.len(), rng.edges.len())
-        ),
+        title: format!("{title}: {} landmarks, {described}", ids.len()),
         landmarks: positions,
         labels: &labels,
         axes,
         edges: &edges,
         true_edges: &[],
-        pruned: &cut.pruned(ids, rng),
+        pruned: &pruned,
         stations: &[],
     };
     outputs.stage(path, |temporary| write_rng(temporary, &picture))?;

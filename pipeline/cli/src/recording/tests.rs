@@ -105,7 +105,7 @@ fn station(index: usize) -> StationRecord {
             associate: 0.02,
             map: 0.5,
             metrics: 0.05,
-            record: 0.0,
+            recording: 0.0,
         },
         warnings: if index == 5 {
             vec!["map rejected the panorama".to_string()]

@@ -158,7 +158,9 @@ impl<C: Calculus> Mapper<C> {
                 station.name,
                 usable.len()
             ));
+            let start = Instant::now();
             record.fusion.resolved_held_back = self.retry_held_back(&mut record);
+            record.seconds.map = start.elapsed().as_secs_f64();
             let start = Instant::now();
             record.metrics = self.refresh_metrics();
             record.seconds.metrics = start.elapsed().as_secs_f64();

@@ -167,7 +167,7 @@ pub struct StageSeconds {
     /// Handing the station to the recorders (run.mcap, run.rrd, with the RNG's layout): 0,
     /// and not written, in the record the recorders get (it is timed around them).
     #[serde(default, skip_serializing_if = "is_zero")]
-    pub record: f64,
+    pub recording: f64,
 }
 
 fn is_zero(seconds: &f64) -> bool {

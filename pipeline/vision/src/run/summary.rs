@@ -45,7 +45,7 @@ pub struct RunSummary {
     #[serde(default)]
     pub seconds_metrics: f64,
     #[serde(default)]
-    pub seconds_record: f64,
+    pub seconds_recording: f64,
     /// Wall time of the parallel decode+detect stage and of the sequential mapping stage.
     pub wall_front_end: f64,
     pub wall_mapping: f64,
@@ -105,7 +105,7 @@ impl RunSummary {
             seconds_associate: sum(|r| r.seconds.associate),
             seconds_map: sum(|r| r.seconds.map),
             seconds_metrics: sum(|r| r.seconds.metrics),
-            seconds_record: sum(|r| r.seconds.record),
+            seconds_recording: sum(|r| r.seconds.recording),
             wall_front_end,
             wall_mapping,
             wall_outputs: 0.0,
@@ -168,7 +168,7 @@ impl fmt::Display for RunSummary {
             self.seconds_associate,
             self.seconds_map,
             self.seconds_metrics,
-            self.seconds_record,
+            self.seconds_recording,
             self.wall_mapping,
             self.wall_outputs
         )

@@ -154,7 +154,7 @@ pub fn map_stations<C: Calculus, E>(
         }
         let recording = Instant::now();
         on_station(&record, &mapper)?;
-        record.seconds.record = recording.elapsed().as_secs_f64();
+        record.seconds.recording = recording.elapsed().as_secs_f64();
         records.push(record);
     }
     progress.end();
