@@ -163,14 +163,8 @@ fn simulates_navigation_and_writes_its_outputs() {
     }
 }
 
-/// `navigate locate` places panoramas against a run's map: every cell it claims holds against
-/// the truth (a certain cell is the true one; a possible set holds it, or names a rock not
-/// identified that may be nearer), and a run's files missing or a right-eye image are errors.
-#[test]
-fn locates_panoramas_against_a_run_soundly() {
-    const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../datasets/demo");
-    let scratch = tempfile::tempdir().unwrap();
-    let dir = scratch.path();
+/// The demo set mapped (and scored) into `dir/run`.
+fn demo_run(dir: &Path) -> std::path::PathBuf {
     let run = dir.join("run");
     let o = pipeline(&[
         "run",
@@ -183,6 +177,19 @@ fn locates_panoramas_against_a_run_soundly() {
         "none",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run
+}
+
+const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../datasets/demo");
+
+/// `navigate locate` places panoramas against a run's map: every cell it claims holds against
+/// the truth (a certain cell is the true one; a possible set holds it, or names a rock not
+/// identified that may be nearer), and a run's files missing or a right-eye image are errors.
+#[test]
+fn locates_panoramas_against_a_run_soundly() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let run = demo_run(dir);
     let map = run.join("map.json");
     let images: Vec<String> = (0..16)
         .step_by(3)
@@ -248,21 +255,9 @@ fn locates_panoramas_against_a_run_soundly() {
 /// trips scrambled (which rock each landmark is), every path is the same step for step.
 #[test]
 fn drives_through_the_rendered_world_without_seeing_it() {
-    const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../datasets/demo");
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path();
-    let run = dir.join("run");
-    let o = pipeline(&[
-        "run",
-        "--images",
-        DEMO,
-        "--out",
-        run.to_str().unwrap(),
-        "--quiet",
-        "--panoramas",
-        "none",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let run = demo_run(dir);
     let drive = |out: &str| {
         let out = dir.join(out);
         let o = pipeline(&[

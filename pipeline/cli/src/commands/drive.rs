@@ -224,19 +224,26 @@ pub fn run(args: &DriveArgs) -> Result<()> {
 
 /// The box the rocks lie in, shrunk by a metre: where starts are drawn.
 fn extent(world: &World) -> (Point, Point) {
-    let xs = world.rocks.iter().map(|r| r.position.x);
-    let ys = world.rocks.iter().map(|r| r.position.y);
-    let (x0, x1) = (
-        xs.clone().fold(f64::INFINITY, f64::min),
-        xs.fold(f64::NEG_INFINITY, f64::max),
-    );
-    let (y0, y1) = (
-        ys.clone().fold(f64::INFINITY, f64::min),
-        ys.fold(f64::NEG_INFINITY, f64::max),
-    );
+    let (low, high) = bounds(world.rocks.iter().map(|r| r.position));
     (
-        Point::new(x0 + 1.0, y0 + 1.0),
-        Point::new(x1 - 1.0, y1 - 1.0),
+        Point::new(low.x + 1.0, low.y + 1.0),
+        Point::new(high.x - 1.0, high.y - 1.0),
+    )
+}
+
+/// The smallest box holding `points`, as its lower and upper corners.
+fn bounds(points: impl Iterator<Item = Point>) -> (Point, Point) {
+    points.fold(
+        (
+            Point::new(f64::INFINITY, f64::INFINITY),
+            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(low, high), p| {
+            (
+                Point::new(low.x.min(p.x), low.y.min(p.y)),
+                Point::new(high.x.max(p.x), high.y.max(p.y)),
+            )
+        },
     )
 }
 
@@ -313,22 +320,14 @@ fn figure(
         .map(|&r| world.rocks[r as usize].position)
         .collect();
     let shown: Vec<&Trip> = trips.iter().take(3).collect();
-    let all_x = raw
-        .iter()
-        .map(|p| p.x)
-        .chain(shown.iter().flat_map(|t| t.path.iter().map(|p| p[0])));
-    let all_y = raw
-        .iter()
-        .map(|p| p.y)
-        .chain(shown.iter().flat_map(|t| t.path.iter().map(|p| p[1])));
-    let (x0, x1) = (
-        all_x.clone().fold(f64::INFINITY, f64::min),
-        all_x.fold(f64::NEG_INFINITY, f64::max),
+    let (low, high) = bounds(
+        raw.iter().copied().chain(
+            shown
+                .iter()
+                .flat_map(|t| t.path.iter().map(|p| Point::new(p[0], p[1]))),
+        ),
     );
-    let (y0, y1) = (
-        all_y.clone().fold(f64::INFINITY, f64::min),
-        all_y.fold(f64::NEG_INFINITY, f64::max),
-    );
+    let (x0, y0, x1, y1) = (low.x, low.y, high.x, high.y);
     let shift = |x: f64, y: f64| (x - x0 + 1.0, y - y0 + 1.0);
     let side = (x1 - x0).max(y1 - y0) + 2.0;
     let rng = estimate(&known.map).expect("EDC has a lune");
