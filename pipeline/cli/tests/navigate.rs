@@ -226,28 +226,25 @@ fn locates_panoramas_against_a_run_soundly() {
     assert!(stdout(&o).contains("over 6 panoramas"), "{}", stdout(&o));
 
     std::fs::remove_file(run.join("landmarks.json")).unwrap();
-    let first = format!("{DEMO}/station_000_left.png");
-    let o = pipeline(&[
-        "navigate",
-        "locate",
-        "--map",
-        map.to_str().unwrap(),
-        "--image",
-        &first,
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("landmarks.json"));
-    let right = format!("{DEMO}/station_000_right.png");
-    let o = pipeline(&[
-        "navigate",
-        "locate",
-        "--map",
-        map.to_str().unwrap(),
-        "--image",
-        &right,
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("right-eye image"));
+    for (image, needle) in [
+        ("station_000_left.png", "landmarks.json"),
+        ("station_000_right.png", "right-eye image"),
+    ] {
+        let image = format!("{DEMO}/{image}");
+        let o = pipeline(&[
+            "navigate",
+            "locate",
+            "--map",
+            map.to_str().unwrap(),
+            "--image",
+            &image,
+        ]);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains(needle),
+            "{image}"
+        );
+    }
 }
 
 /// `navigate drive` runs closed-loop trips through the demo set's rendered world and writes

@@ -10,7 +10,7 @@ use qrm_atomic_file::OutputSet;
 use qrm_core::geometry::Point;
 use qrm_core::map::LandmarkId;
 use qrm_core::navigation::{RouteCost, RouteGraph};
-use qrm_core::neighborhood::{estimate, true_rng};
+use qrm_core::neighborhood::{estimate, true_rng, RngEstimate};
 use qrm_plot::{write_flow, FlowPicture};
 use qrm_synth::closed_loop::{drive, Driving, Outcome, Terrain, Trip, CLEARANCE_M};
 use qrm_synth::dataset::{Counts, Preset};
@@ -196,7 +196,7 @@ pub fn run(args: &DriveArgs) -> Result<()> {
             .stage_bytes(&path, (json + "\n").as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let picture = figure(&world, &landmark_rocks, &known, &trips);
+    let picture = figure(&world, &landmark_rocks, &rng_estimate, &trips);
     outputs.stage(&args.out.join("drive.png"), |temporary| {
         write_flow(temporary, &picture)
     })?;
@@ -311,7 +311,7 @@ fn summarize(trips: &[Trip]) -> serde_json::Value {
 fn figure(
     world: &World,
     landmark_rocks: &BTreeMap<LandmarkId, u32>,
-    known: &qrm_vision::localization::KnownMap<qrm_core::edc::Edc>,
+    rng: &RngEstimate,
     trips: &[Trip],
 ) -> FlowPicture {
     let ids: Vec<LandmarkId> = landmark_rocks.keys().copied().collect();
@@ -330,7 +330,6 @@ fn figure(
     let (x0, y0, x1, y1) = (low.x, low.y, high.x, high.y);
     let shift = |x: f64, y: f64| (x - x0 + 1.0, y - y0 + 1.0);
     let side = (x1 - x0).max(y1 - y0) + 2.0;
-    let rng = estimate(&known.map).expect("EDC has a lune");
     let index = |l: LandmarkId| ids.iter().position(|&i| i == l);
     let edges: Vec<(usize, usize, f64)> = rng
         .edges
