@@ -83,6 +83,12 @@ enum Command {
     /// navigation with an ideal sensor (docs/NAVIGATION.md).
     #[command(subcommand)]
     Navigate(commands::navigate::NavigateCommand),
+    /// Route directions a person or rover can follow (004 Park & Kender) from a run's map:
+    /// legs "of the n − 1 landmarks nearest to you, head for the most isolated", routes by
+    /// distance, reliability or their compromise, checks to verify each arrival and recover
+    /// from a wrong one, and a picture of every target rock (docs/DIRECTIONS.md), e.g.
+    /// `directions --run demo-run --images datasets/demo --from 3 --to 12 --out dir`.
+    Directions(commands::directions::DirectionsArgs),
     /// Render a synthetic dataset: stereo panoramas of a rock field with ground truth
     /// (datasets/README.md), e.g. `synth --preset marsyard --seed 1 --out data/marsyard`.
     Synth(commands::synth::SynthArgs),
@@ -223,6 +229,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Navigate(command) => commands::navigate::run_command(command)?,
         Command::Synth(args) => commands::synth::run(args)?,
         Command::Run(args) => commands::run::run(args)?,
+        Command::Directions(args) => commands::directions::run(&args)?,
         Command::Eval(args) => commands::eval::run(args)?,
     }
     Ok(())

@@ -1472,6 +1472,76 @@ fn bad_maps_and_networks() {
     check_bad_input("map", map_cases());
 }
 
+/// `directions` over a run or map it cannot use.
+fn directions_cases() -> Vec<Case> {
+    const DIRECTIONS: &str = "directions --run {dir}/out --from 0 --to 1";
+    vec![
+        Case::new(
+            "directions: a landmark the map lacks",
+            "directions --run {dir}/out --from 0 --to 999",
+            &["landmark 999 is not in the map"],
+        )
+        .setup(demo_run),
+        Case::new(
+            "directions: no route on the legs the map proves",
+            "directions --run {dir}/out --from 0 --to 1 --samples 0",
+            &["no route from landmark 0 to landmark 1", "0 proven"],
+        )
+        .setup(demo_run),
+        Case::new(
+            "directions: a run directory without stations.json",
+            DIRECTIONS,
+            &["cannot read", "stations.json"],
+        )
+        .setup(|d| {
+            demo_run(d);
+            std::fs::remove_file(d.join("out/stations.json")).unwrap();
+        }),
+        Case::new(
+            "directions: a run whose stations.json lists none",
+            DIRECTIONS,
+            &["lists no stations"],
+        )
+        .setup(|d| {
+            demo_run(d);
+            std::fs::write(d.join("out/stations.json"), "[]").unwrap();
+        }),
+        Case::new(
+            "directions: a run directory that does not exist",
+            "directions --run {dir}/nowhere --from 0 --to 1",
+            &["nowhere", "does not exist"],
+        ),
+        Case::new(
+            "directions: an FDC map",
+            "directions --map {dir}/fdc/map.json --from 0 --to 1",
+            &["FDC map cannot rank neighbours"],
+        )
+        .setup(maps),
+        Case::new(
+            "directions: a scene beyond the reliability model",
+            "directions --map {dir}/sim/map.json --from 0 --to 1 --scene 9",
+            &["--scene 9"],
+        )
+        .setup(maps),
+        Case::new(
+            "directions: pictures without a run",
+            "directions --map {dir}/sim/map.json --images {dir} --from 0 --to 1",
+            &["--run"],
+        )
+        .setup(maps),
+        Case::new(
+            "simulate directions: no trials",
+            "simulate directions --trials 0 --out {dir}/study",
+            &["--trials and --routes must be positive"],
+        ),
+    ]
+}
+
+#[test]
+fn bad_directions() {
+    check_bad_input("directions", directions_cases());
+}
+
 #[test]
 fn bad_arguments() {
     check_bad_input("argument", argument_cases());
@@ -1488,6 +1558,7 @@ fn the_suite_holds_enough_cases() {
         earlier_run_cases().len(),
         map_cases().len(),
         argument_cases().len(),
+        directions_cases().len(),
     ];
     assert!(tables.iter().sum::<usize>() >= 55, "{tables:?}");
 }

@@ -1,6 +1,7 @@
 //! The `pipeline` binary end to end: one test binary, a module per group of commands.
 
 mod bad_input;
+mod directions;
 mod navigate;
 mod run;
 mod subcommands;

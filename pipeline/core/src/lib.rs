@@ -47,6 +47,7 @@
 //! ```
 
 pub mod calculus;
+pub mod directions;
 pub mod edc;
 pub mod fdc;
 pub mod feasibility;

@@ -19,6 +19,7 @@ mod output;
 mod palette;
 mod panels;
 mod panorama;
+mod reliability;
 mod rng;
 mod ticks;
 
@@ -28,6 +29,7 @@ pub use flow::{write_flow, FlowPicture};
 pub use layout::spring_layout;
 pub use panels::{write_panels, Curve, Panel};
 pub use panorama::{write_panorama, AnnotatedPanorama, Mark, MarkKind, RgbImage};
+pub use reliability::{write_reliability, CalibrationPoint, ReliabilityPicture, SelectionSeries};
 pub use rng::{write_rng, Axes, RngPicture};
 
 #[cfg(test)]

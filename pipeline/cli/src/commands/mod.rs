@@ -1,5 +1,6 @@
 //! Subcommands of the `pipeline` binary beyond the calculus tools in `main.rs`.
 
+pub mod directions;
 pub mod drive;
 pub mod eval;
 pub mod locate;

@@ -304,6 +304,12 @@ fn mark(d: &DetectionRecord, fused: Option<LandmarkId>, scale: f64) -> Mark {
 /// The box `bbox` with some context around it, across the seam if it wraps, shrunk to fit a
 /// tile.
 fn crop(image: &RgbImage, bbox: [u32; 4]) -> RgbImage {
+    crop_with_context(image, bbox).1
+}
+
+/// The box `bbox` with some context around it, across the seam if it wraps: at the image's
+/// resolution, and shrunk to fit a contact-sheet tile.
+pub(super) fn crop_with_context(image: &RgbImage, bbox: [u32; 4]) -> (RgbImage, RgbImage) {
     let (width, height) = (image.width() as i64, image.height() as i64);
     let [c0, r0, c1, r1] = bbox.map(i64::from);
     let margin_c = ((c1 - c0 + 1) as f64 * CROP_MARGIN).ceil() as i64;
@@ -320,7 +326,8 @@ fn crop(image: &RgbImage, bbox: [u32; 4]) -> RgbImage {
         ((f64::from(w) * scale) as u32).clamp(1, TILE.0),
         ((f64::from(h) * scale) as u32).clamp(1, TILE.1),
     );
-    imageops::resize(&piece, fitted.0, fitted.1, FilterType::CatmullRom)
+    let tile = imageops::resize(&piece, fitted.0, fitted.1, FilterType::CatmullRom);
+    (piece, tile)
 }
 
 fn plot_image(image: &RgbImage) -> qrm_plot::RgbImage<'_> {

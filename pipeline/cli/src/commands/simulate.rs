@@ -34,6 +34,11 @@ pub enum SimulateCommand {
     /// 003 Fig. 1.5: four landmarks, imaging points chosen one by one where they constrain the
     /// map most, until it is fully constrained.
     Basic(BasicArgs),
+    /// The reliability of route-direction legs (004 §6.1.2) refitted for the rover by Monte
+    /// Carlo (Eq. 1 over scene size n and range error σ), and routes followed with noisy
+    /// perception against their predicted reliability. Writes reliability.json and
+    /// reliability.png (docs/DIRECTIONS.md).
+    Directions(super::directions::DirectionsStudyArgs),
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -133,6 +138,7 @@ pub struct BasicArgs {
 pub fn run_command(command: SimulateCommand) -> Result<()> {
     match command {
         SimulateCommand::Montecarlo(args) => montecarlo(args),
+        SimulateCommand::Directions(args) => super::directions::study(&args),
         SimulateCommand::Single(args) => match args.calculus {
             CalculusName::Edc => single::<Edc>(&args),
             CalculusName::Fdc => single::<Fdc>(&args),
@@ -493,7 +499,7 @@ fn basic<C: Calculus>(seed: u64) -> Result<()> {
     Ok(())
 }
 
-fn progress(len: u64, what: &str) -> ProgressBar {
+pub(super) fn progress(len: u64, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len);
     bar.set_style(
         ProgressStyle::with_template(
