@@ -1530,6 +1530,12 @@ fn directions_cases() -> Vec<Case> {
         )
         .setup(maps),
         Case::new(
+            "directions: from a landmark to itself",
+            "directions --map {dir}/sim/map.json --from 3 --to 3",
+            &["you are there"],
+        )
+        .setup(maps),
+        Case::new(
             "simulate directions: no trials",
             "simulate directions --trials 0 --out {dir}/study",
             &["--trials and --routes must be positive"],

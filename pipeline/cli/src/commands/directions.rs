@@ -171,6 +171,12 @@ pub fn run(args: &DirectionsArgs) -> Result<()> {
             args.scene
         );
     }
+    if args.from == args.to {
+        bail!(
+            "--from and --to are both landmark {}: you are there",
+            args.from
+        );
+    }
     if args.images.is_some() && args.run.is_none() {
         bail!("--images needs --run: the pictures come from the run's stations and landmarks");
     }
@@ -573,13 +579,27 @@ fn stage_leg_pictures(
     stations: &[StationRecord],
     images: &FsPath,
 ) -> Result<()> {
-    let size = stations
+    let sheet = out.join("legs.png");
+    let first = stations
         .iter()
         .find_map(|s| s.files.first())
-        .map(|f| images.join(f))
-        .with_context(|| "the run's stations name no image files".to_string())?;
-    let size = image::image_dimensions(&size)
-        .with_context(|| format!("cannot read {}", size.display()))?;
+        .map(|f| images.join(f));
+    let size = match first.as_deref().map(|f| (f, image::image_dimensions(f))) {
+        Some((_, Ok(size))) => size,
+        Some((f, Err(e))) => {
+            eprintln!(
+                "warning: no pictures of the legs: cannot read {}: {e}",
+                f.display()
+            );
+            outputs.remove_stale(&sheet);
+            return Ok(());
+        }
+        None => {
+            eprintln!("warning: no pictures of the legs: the run's stations name no image files");
+            outputs.remove_stale(&sheet);
+            return Ok(());
+        }
+    };
     let mut tiles: Vec<(RgbImage, String, String)> = Vec::new();
     for (k, step) in d.steps.iter().enumerate() {
         let target = d.ids[step.leg.to];
@@ -610,8 +630,13 @@ fn stage_leg_pictures(
         let Some(det) = record.detections.get(detection) else {
             continue;
         };
-        let panorama = read_image(&images.join(file), size)
-            .with_context(|| format!("cannot read {}", images.join(file).display()))?;
+        let panorama = match read_image(&images.join(file), size) {
+            Ok(panorama) => panorama,
+            Err(e) => {
+                eprintln!("warning: no picture for leg {}: {e}", k + 1);
+                continue;
+            }
+        };
         let (full, fitted) = crop_with_context(&panorama, det.bbox);
         let path = out.join(format!("leg_{}.png", k + 1));
         let mut bytes = Vec::new();
@@ -632,7 +657,6 @@ fn stage_leg_pictures(
             format!("{}, {}", choice(&step.leg), record.station),
         ));
     }
-    let sheet = out.join("legs.png");
     if tiles.is_empty() {
         outputs.remove_stale(&sheet);
         return Ok(());
