@@ -12,10 +12,11 @@ use qrm_atomic_file::OutputSet;
 use qrm_core::directions::calibration::{
     calibration_bins, follow_routes, CalibrationSettings, Followed,
 };
+use qrm_core::directions::isolation::neighbour_ranks;
 use qrm_core::directions::reliability::{selection_rate, SelectionRate};
 use qrm_core::directions::{
-    criteria, custom_map, rng_degrees, sampled_legs, steps, Criterion, Descriptor, LegGraph, Path,
-    ReliabilityModel, Routes, Step, ViewNoise,
+    criteria, custom_map, rng_degrees, sampled_legs, steps, Criterion, Descriptor, LegGraph,
+    MapNearness, Path, ReliabilityModel, Routes, Step, ViewNoise,
 };
 use qrm_core::edc::{self, Edc};
 use qrm_core::map::{Hypergraph, LandmarkId};
@@ -254,10 +255,20 @@ fn plan(map: &Hypergraph<Edc>, args: &DirectionsArgs) -> Result<Directions> {
             None
         }
     };
+    let nearness = MapNearness::new(map);
+    // The landmark the map proves nearest (rank 1 for certain), for the side cue.
+    let nearest = |r: usize| {
+        neighbour_ranks(&nearness, r)
+            .iter()
+            .enumerate()
+            .find(|&(y, rank)| y != r && rank.high == 1)
+            .map(|(y, _)| y)
+    };
     let steps = steps(
         &graph.legs_of(routes.get(criterion)),
         &graph.legs,
         &signatures,
+        nearest,
         left,
     );
     let per_leg = criteria::per_leg_compromise(&graph.arcs, graph.nodes(), from, to);

@@ -315,8 +315,10 @@ pub(super) fn crop_with_context(image: &RgbImage, bbox: [u32; 4]) -> (RgbImage, 
     let margin_c = ((c1 - c0 + 1) as f64 * CROP_MARGIN).ceil() as i64;
     let margin_r = ((r1 - r0 + 1) as f64 * CROP_MARGIN).ceil() as i64;
     let (c0, c1) = (c0 - margin_c, c1 + margin_c);
-    let (r0, r1) = ((r0 - margin_r).max(0), (r1 + margin_r).min(height - 1));
-    let (w, h) = ((c1 - c0 + 1).min(width) as u32, (r1 - r0 + 1) as u32);
+    // A box from a record (stations.json) may lie outside the image: clamp, keep a pixel.
+    let r0 = (r0 - margin_r).clamp(0, height - 1);
+    let r1 = (r1 + margin_r).clamp(r0, height - 1);
+    let (w, h) = ((c1 - c0 + 1).clamp(1, width) as u32, (r1 - r0 + 1) as u32);
     let piece = RgbImage::from_fn(w, h, |x, y| {
         let column = (c0 + i64::from(x)).rem_euclid(width);
         *image.get_pixel(column as u32, (r0 + i64::from(y)) as u32)

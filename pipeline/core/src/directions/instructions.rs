@@ -62,13 +62,15 @@ pub fn rng_degrees(landmarks: &[LandmarkId], rng: &RngEstimate) -> Vec<Bounds> {
     degrees
 }
 
-/// The steps of a route (its legs, in order). `legs` are all the map's legs (recovery looks
-/// for a leg from a mistaken landmark to the target); `signatures` each landmark's signature;
-/// `left(r, n, t)` whether `t` is certainly left (`Some(true)`) or right of the line `r → n`.
+/// The steps of a route (its legs, in order). `legs` are all the map's legs (recovery uses a
+/// proven leg from a mistaken landmark to the target); `signatures` each landmark's signature;
+/// `nearest(r)` the landmark the map proves nearest to `r`, if any; `left(r, n, t)` whether
+/// `t` is certainly left (`Some(true)`) or right of the line `r → n`.
 pub fn steps(
     route: &[&Leg],
     legs: &[Leg],
     signatures: &[Bounds],
+    nearest: impl Fn(usize) -> Option<usize>,
     left: impl Fn(usize, usize, usize) -> Option<bool>,
 ) -> Vec<Step> {
     route
@@ -91,7 +93,9 @@ pub fn steps(
                                 .confusable()
                                 .filter(|&z| z != y)
                                 .all(|z| !signatures[z].contains(q.low));
-                        let back = legs.iter().find(|l| l.from == y && l.to == leg.to)?;
+                        let back = legs
+                            .iter()
+                            .find(|l| l.from == y && l.to == leg.to && l.is_proven())?;
                         unique.then(|| Recovery {
                             signature: q.low,
                             leg: back.clone(),
@@ -99,14 +103,9 @@ pub fn steps(
                     })
                     .collect(),
             };
-            let nearest = leg.scene[1];
-            let side = (nearest != leg.to)
-                .then(|| left(leg.from, nearest, leg.to))
-                .flatten()
-                .map(|left| SideCue {
-                    towards: nearest,
-                    left,
-                });
+            let side = nearest(leg.from)
+                .filter(|&n| n != leg.to)
+                .and_then(|n| left(leg.from, n, leg.to).map(|left| SideCue { towards: n, left }));
             Step {
                 leg: leg.clone(),
                 verify,
@@ -183,7 +182,13 @@ mod tests {
             Bounds::exact(4),
         ];
         let legs = vec![leg(0, 3, &[0, 1, 2, 3]), leg(1, 3, &[1, 3])];
-        let steps = steps(&[&legs[0]], &legs, &signatures, |_, _, _| Some(true));
+        let steps = steps(
+            &[&legs[0]],
+            &legs,
+            &signatures,
+            |_| Some(1),
+            |_, _, _| Some(true),
+        );
         let step = &steps[0];
         assert_eq!(step.verify, Some(4));
         // 1's signature 2 is also possible for 2: no recovery from 1; 2's is not exact.
@@ -203,7 +208,13 @@ mod tests {
             Bounds::exact(1),
             Bounds::exact(4),
         ];
-        let steps = super::steps(&[&legs[0], &legs[1]], &legs, &signatures, |_, _, _| None);
+        let steps = super::steps(
+            &[&legs[0], &legs[1]],
+            &legs,
+            &signatures,
+            |_| None,
+            |_, _, _| Some(true),
+        );
         assert_eq!(steps[0].recover.len(), 1);
         assert_eq!(steps[0].recover[0].leg.from, 1);
         assert_eq!(steps[0].side, None);
@@ -217,7 +228,7 @@ mod tests {
     fn an_undetectable_target_gets_no_items() {
         let signatures = [Bounds::exact(1), Bounds::exact(2), Bounds::exact(2)];
         let legs = vec![leg(0, 2, &[0, 1, 2])];
-        let steps = steps(&[&legs[0]], &legs, &signatures, |_, _, _| None);
+        let steps = steps(&[&legs[0]], &legs, &signatures, |_| None, |_, _, _| None);
         assert_eq!(steps[0].verify, None);
         assert!(steps[0].recover.is_empty());
     }

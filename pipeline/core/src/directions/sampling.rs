@@ -44,7 +44,7 @@ pub fn sampled_legs(
         .into_par_iter()
         .filter_map(|k| {
             let realization = map.realize(&RealizeSettings {
-                seed: seed + k,
+                seed: seed.wrapping_add(k),
                 sweeps: SWEEPS,
                 restarts: 1,
             });
