@@ -156,3 +156,70 @@ fn the_reliability_study_writes_its_figure() {
     assert_eq!(r["calibration"]["routes"], 60);
     assert!(out.join("reliability.png").is_file());
 }
+
+/// `navigate directions`: routes planned on the demo run's map, followed through panoramas
+/// rendered in its world; the same seed gives the same trials, every leg is judged, and a run
+/// without eval.json (which rock each landmark is) is refused.
+#[test]
+fn directions_followed_through_rendered_panoramas() {
+    let scratch = tempfile::tempdir().unwrap();
+    let run = scratch.path().join("run");
+    let o = pipeline(&[
+        "run",
+        "--images",
+        DEMO,
+        "--out",
+        run.to_str().unwrap(),
+        "--quiet",
+        "--panoramas",
+        "none",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let trial = |out: &str| {
+        let out = scratch.path().join(out);
+        let o = pipeline(&[
+            "navigate",
+            "directions",
+            "--images",
+            DEMO,
+            "--run",
+            run.to_str().unwrap(),
+            "--routes",
+            "3",
+            "--samples",
+            "4",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(out.join("summary.json").is_file());
+        json(&out.join("trials.json"))
+    };
+    let first = trial("a");
+    let routes = first.as_array().unwrap();
+    assert_eq!(routes.len(), 3);
+    for route in routes {
+        let legs = route["legs"].as_array().unwrap();
+        assert_eq!(legs.len() + 1, route["landmarks"].as_array().unwrap().len());
+        let all = legs.iter().all(|l| l["correct_identified"] == true);
+        assert_eq!(route["succeeded_identified"], all);
+        for leg in legs {
+            let p = leg["predicted"].as_f64().unwrap();
+            assert!(p > 0.0 && p <= 1.0);
+        }
+    }
+    assert_eq!(trial("b"), first, "the same seed gave other trials");
+    std::fs::remove_file(run.join("eval.json")).unwrap();
+    let o = pipeline(&[
+        "navigate",
+        "directions",
+        "--images",
+        DEMO,
+        "--run",
+        run.to_str().unwrap(),
+        "--out",
+        scratch.path().join("c").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("eval.json"));
+}

@@ -29,7 +29,9 @@ pub use flow::{write_flow, FlowPicture};
 pub use layout::spring_layout;
 pub use panels::{write_panels, Curve, Panel};
 pub use panorama::{write_panorama, AnnotatedPanorama, Mark, MarkKind, RgbImage};
-pub use reliability::{write_reliability, CalibrationPoint, ReliabilityPicture, SelectionSeries};
+pub use reliability::{
+    write_reliability, CalibrationPoint, CalibrationSeries, ReliabilityPicture, SelectionSeries,
+};
 pub use rng::{write_rng, Axes, RngPicture};
 
 #[cfg(test)]

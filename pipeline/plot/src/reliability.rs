@@ -18,15 +18,23 @@ use plotters::prelude::{
 use plotters::style::{Color, IntoFont, RGBColor, WHITE};
 use std::path::Path;
 
-/// Measured selection rates and the fitted model at one range error σ.
+/// Measured selection rates, and the model they are compared with.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SelectionSeries {
-    /// Legend text, e.g. `σ = 0.1`.
+    /// Legend text, e.g. `σ = 0.1: measured (dots), Eq. (1) fit (line)`.
     pub label: String,
-    /// `(n, measured rate)`.
+    /// `(n, measured rate)`, drawn as dots.
     pub measured: Vec<(f64, f64)>,
-    /// `(n, model)`, drawn as a line.
+    /// `(n, model)`, drawn as a line (none when empty).
     pub fitted: Vec<(f64, f64)>,
+}
+
+/// Routes of one kind, binned by predicted reliability.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CalibrationSeries {
+    /// Legend text, e.g. `routes: measured success per bin, 95 % interval`.
+    pub label: String,
+    pub points: Vec<CalibrationPoint>,
 }
 
 /// One bin of the calibration plot.
@@ -43,14 +51,15 @@ pub struct CalibrationPoint {
 pub struct ReliabilityPicture {
     pub title: String,
     pub selection: Vec<SelectionSeries>,
-    pub calibration: Vec<CalibrationPoint>,
+    pub calibration: Vec<CalibrationSeries>,
     /// Caption of the calibration panel, e.g. how many routes.
     pub calibration_title: String,
 }
 
 const SIZE: (u32, u32) = (1500, 760);
 const DIAGONAL: RGBColor = RGBColor(150, 150, 150);
-const BIN: RGBColor = RGBColor(31, 119, 180);
+/// Colours of the calibration series (apart from the selection panel's): black, then purple.
+const BINS: [RGBColor; 2] = [RGBColor(0, 0, 0), RGBColor(148, 60, 200)];
 
 /// Writes `picture` to `path` (`.png`, 1500×760 pixels, or `.svg`). Fails without writing when
 /// there is nothing to draw or a value is outside `[0, 1]` (rates) or not finite.
@@ -66,8 +75,11 @@ fn validate(picture: &ReliabilityPicture) -> Result<(), String> {
     if picture.selection.iter().all(|s| s.measured.is_empty()) {
         return Err("no selection rates to draw".into());
     }
-    if picture.calibration.is_empty() {
+    if picture.calibration.iter().all(|c| c.points.is_empty()) {
         return Err("no calibration bins to draw".into());
+    }
+    if picture.calibration.len() > BINS.len() {
+        return Err(format!("at most {} calibration series", BINS.len()));
     }
     let rate = |v: f64| (0.0..=1.0).contains(&v);
     for s in &picture.selection {
@@ -80,7 +92,7 @@ fn validate(picture: &ReliabilityPicture) -> Result<(), String> {
             }
         }
     }
-    for b in &picture.calibration {
+    for b in picture.calibration.iter().flat_map(|c| &c.points) {
         if ![b.predicted, b.measured, b.low, b.high]
             .into_iter()
             .all(rate)
@@ -113,14 +125,20 @@ impl Figure for ReliabilityPicture {
             .iter()
             .enumerate()
             .map(|(i, s)| Entry {
-                key: Key::Line(curve_colour(i, count)),
-                label: format!("{}: measured (dots), Eq. (1) fit (line)", s.label),
+                key: if s.fitted.is_empty() {
+                    Key::Circle(curve_colour(i, count))
+                } else {
+                    Key::Line(curve_colour(i, count))
+                },
+                label: s.label.clone(),
             })
             .collect();
-        entries.push(Entry {
-            key: Key::Circle(BIN),
-            label: "routes: measured success per bin, 95 % interval".into(),
-        });
+        for (series, colour) in self.calibration.iter().zip(BINS) {
+            entries.push(Entry {
+                key: Key::Circle(colour),
+                label: series.label.clone(),
+            });
+        }
         entries.push(Entry {
             key: Key::Dashed(DIAGONAL),
             label: "perfect calibration".into(),
@@ -189,8 +207,8 @@ impl ReliabilityPicture {
             .build_cartesian_2d(0.0..1.0, 0.0..1.02)?;
         chart
             .configure_mesh()
-            .x_desc("predicted route reliability e^−U")
-            .y_desc("routes followed to the goal")
+            .x_desc("predicted reliability e^−U")
+            .y_desc("measured: intended landmark(s) reached")
             .label_style((FAMILY, 18).into_font())
             .axis_desc_style((FAMILY, 20).into_font())
             .light_line_style(RGBColor(243, 243, 243))
@@ -202,21 +220,26 @@ impl ReliabilityPicture {
             6,
             DIAGONAL.stroke_width(2),
         )))?;
-        for b in &self.calibration {
-            chart.draw_series(std::iter::once(PathElement::new(
-                vec![(b.predicted, b.low), (b.predicted, b.high)],
-                BIN.stroke_width(2),
-            )))?;
-            chart.draw_series(std::iter::once(Circle::new(
-                (b.predicted, b.measured),
-                6,
-                BIN.filled(),
-            )))?;
-            chart.draw_series(std::iter::once(Text::new(
-                format!("{}", b.routes),
-                (b.predicted + 0.012, b.measured - 0.015),
-                (FAMILY, 16).into_font(),
-            )))?;
+        for (k, (series, colour)) in self.calibration.iter().zip(BINS).enumerate() {
+            // A second series is nudged right so that its intervals do not hide the first's.
+            let nudge = 0.008 * k as f64;
+            for b in &series.points {
+                let x = b.predicted + nudge;
+                chart.draw_series(std::iter::once(PathElement::new(
+                    vec![(x, b.low), (x, b.high)],
+                    colour.stroke_width(2),
+                )))?;
+                chart.draw_series(std::iter::once(Circle::new(
+                    (x, b.measured),
+                    6,
+                    colour.filled(),
+                )))?;
+                chart.draw_series(std::iter::once(Text::new(
+                    format!("{}", b.routes),
+                    (x + 0.012, b.measured - 0.015),
+                    (FAMILY, 16).into_font(),
+                )))?;
+            }
         }
         Ok(())
     }
@@ -235,12 +258,15 @@ mod tests {
                 measured: vec![(2.0, 0.95), (3.0, 0.9), (4.0, 0.85)],
                 fitted: vec![(2.0, 0.96), (4.0, 0.84)],
             }],
-            calibration: vec![CalibrationPoint {
-                predicted: 0.7,
-                measured: 0.65,
-                low: 0.55,
-                high: 0.75,
-                routes: 80,
+            calibration: vec![CalibrationSeries {
+                label: "routes".into(),
+                points: vec![CalibrationPoint {
+                    predicted: 0.7,
+                    measured: 0.65,
+                    low: 0.55,
+                    high: 0.75,
+                    routes: 80,
+                }],
             }],
             calibration_title: "(b) 80 routes".into(),
         }
@@ -254,7 +280,7 @@ mod tests {
         assert_eq!(png_size(&png), SIZE);
         write_reliability(&dir.join("reliability.svg"), &picture()).unwrap();
         let mut bad = picture();
-        bad.calibration[0].measured = 1.5;
+        bad.calibration[0].points[0].measured = 1.5;
         let error = write_reliability(&dir.join("bad.png"), &bad).unwrap_err();
         assert!(error.to_string().contains("outside [0, 1]"), "{error}");
         assert!(!dir.join("bad.png").exists());

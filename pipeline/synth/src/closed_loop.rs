@@ -118,7 +118,7 @@ pub struct Terrain<'a> {
 
 impl Terrain<'_> {
     /// The stereo pair at `pose`.
-    fn panoramas(&self, pose: Pose) -> (RgbImage, RgbImage) {
+    pub(crate) fn panoramas(&self, pose: Pose) -> (RgbImage, RgbImage) {
         let image = |eye| {
             let r = render(self.world, self.calib, pose, eye);
             RgbImage::from_raw(r.width, r.height, r.rgb).expect("a render fills its image")
@@ -127,7 +127,7 @@ impl Terrain<'_> {
     }
 
     /// Whether `p` lies within `margin` of a rock's footprint.
-    fn blocked(&self, p: Point, margin: f64) -> bool {
+    pub(crate) fn blocked(&self, p: Point, margin: f64) -> bool {
         self.world
             .rocks
             .iter()

@@ -13,6 +13,7 @@
 
 pub mod closed_loop;
 pub mod dataset;
+pub mod directions_trial;
 pub mod evaluation;
 
 mod capture;

@@ -22,8 +22,8 @@ use qrm_core::edc::{self, Edc};
 use qrm_core::map::{Hypergraph, LandmarkId};
 use qrm_core::neighborhood::estimate;
 use qrm_plot::{
-    write_contact_sheet, write_reliability, CalibrationPoint, ContactSheet, ReliabilityPicture,
-    SelectionSeries, Tile,
+    write_contact_sheet, write_reliability, CalibrationPoint, CalibrationSeries, ContactSheet,
+    ReliabilityPicture, SelectionSeries, Tile,
 };
 use qrm_vision::run::{LandmarkRecord, StationRecord};
 use qrm_vision::survey::read_image;
@@ -735,6 +735,19 @@ pub struct DirectionsStudyArgs {
     out: PathBuf,
 }
 
+/// Calibration bins as the figure draws them.
+fn points(bins: &[qrm_core::directions::calibration::CalibrationBin]) -> Vec<CalibrationPoint> {
+    bins.iter()
+        .map(|b| CalibrationPoint {
+            predicted: b.predicted,
+            measured: b.measured,
+            low: b.low,
+            high: b.high,
+            routes: b.routes,
+        })
+        .collect()
+}
+
 /// Range errors of the fit.
 const FIT_SIGMAS: [f64; 4] = [0.05, 0.1, 0.2, 0.3];
 /// Scene sizes of the fit.
@@ -767,6 +780,7 @@ pub fn study(args: &DirectionsStudyArgs) -> Result<()> {
                 ViewNoise {
                     bearing_sd,
                     range_sd: sigma,
+                    standoff: 1.0,
                 },
                 args.trials,
                 args.seed,
@@ -782,6 +796,7 @@ pub fn study(args: &DirectionsStudyArgs) -> Result<()> {
         noise: ViewNoise {
             bearing_sd,
             range_sd: args.range_error,
+            standoff: 1.0,
         },
         model,
         criterion: args.criterion.criterion(),
@@ -826,7 +841,7 @@ pub fn study(args: &DirectionsStudyArgs) -> Result<()> {
         selection: FIT_SIGMAS
             .iter()
             .map(|&sigma| SelectionSeries {
-                label: format!("σ = {sigma}"),
+                label: format!("σ = {sigma}: measured (dots), Eq. (1) fit (line)"),
                 measured: rates
                     .iter()
                     .filter(|r| r.sigma == sigma)
@@ -837,16 +852,10 @@ pub fn study(args: &DirectionsStudyArgs) -> Result<()> {
                     .collect(),
             })
             .collect(),
-        calibration: bins
-            .iter()
-            .map(|b| CalibrationPoint {
-                predicted: b.predicted,
-                measured: b.measured,
-                low: b.low,
-                high: b.high,
-                routes: b.routes,
-            })
-            .collect(),
+        calibration: vec![CalibrationSeries {
+            label: "routes: measured success per bin, 95 % interval".into(),
+            points: points(&bins),
+        }],
         calibration_title: format!(
             "(b) {} {:?} routes followed, σ = {} (routes per bin)",
             followed.len(),
@@ -918,5 +927,309 @@ pub fn study(args: &DirectionsStudyArgs) -> Result<()> {
         args.out.display(),
         started.elapsed().as_secs_f64()
     );
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+pub struct TrialArgs {
+    /// The synthetic dataset whose world is rendered (truth.json, calib.toml).
+    #[arg(long)]
+    images: PathBuf,
+    /// The run over that dataset whose map the routes are planned on (with eval.json, which
+    /// says which rock each landmark is, for judging).
+    #[arg(long)]
+    run: PathBuf,
+    /// Routes to follow.
+    #[arg(long, default_value_t = 200)]
+    routes: usize,
+    #[arg(long, value_enum, default_value = "compromise")]
+    criterion: CriterionName,
+    /// Largest scene a leg may use.
+    #[arg(long, default_value_t = 6)]
+    scene: usize,
+    /// Realizations of the map to sample legs from.
+    #[arg(long, default_value_t = 16)]
+    samples: usize,
+    /// The range error σ the routes are planned with (compare the measured one it prints).
+    #[arg(long, default_value_t = 0.1)]
+    range_error: f64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output directory: trials.json, summary.json, calibration.png.
+    #[arg(long, default_value = "directions-trials")]
+    out: PathBuf,
+}
+
+/// Start/goal draws before the trial gives up finding routes.
+const ROUTE_ATTEMPTS: usize = 100;
+
+/// `navigate directions`: routes planned on a run's map, followed through panoramas rendered
+/// in its dataset's world (`qrm_synth::directions_trial`).
+pub fn trial(args: &TrialArgs) -> Result<()> {
+    use qrm_synth::closed_loop::Terrain;
+    use qrm_synth::directions_trial::{follow_route, RouteTrial};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use rayon::prelude::*;
+
+    if args.routes == 0 {
+        bail!("--routes must be at least 1");
+    }
+    if !(2..=MAX_SCENE).contains(&args.scene) {
+        bail!("--scene {} must be 2..={MAX_SCENE}", args.scene);
+    }
+    if !(0.0..=1.0).contains(&args.range_error) {
+        bail!("--range-error {} must be in 0..=1", args.range_error);
+    }
+    let started = Instant::now();
+    let (calib, world, origin) = super::drive::rendered_world(&args.images)?;
+    let (known, landmark_rocks) = super::drive::run_of(&args.run, &world, &args.images)?;
+    let map = &known.map;
+    let ids = map.landmarks().to_vec();
+    let sampled = sampled_legs(map, args.scene, args.samples, args.seed);
+    let graph = LegGraph::from_legs(
+        sampled.legs,
+        ids.len(),
+        &ReliabilityModel::ROVER,
+        args.range_error,
+    );
+    let usable: Vec<usize> = (0..ids.len())
+        .filter(|&i| landmark_rocks.contains_key(&ids[i]))
+        .collect();
+    // The routes: random start/goal pairs of landmarks that stand for rocks, with a route.
+    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let mut planned = Vec::new();
+    let mut attempts = 0;
+    while planned.len() < args.routes && usable.len() >= 2 {
+        attempts += 1;
+        if attempts > ROUTE_ATTEMPTS * args.routes {
+            break;
+        }
+        let (from, to) = (
+            usable[rng.random_range(0..usable.len())],
+            usable[rng.random_range(0..usable.len())],
+        );
+        if from == to {
+            continue;
+        }
+        if let Some(routes) = graph.routes(from, to) {
+            let path = routes.get(args.criterion.criterion()).clone();
+            if path
+                .nodes
+                .iter()
+                .all(|n| landmark_rocks.contains_key(&ids[*n]))
+            {
+                planned.push(path);
+            }
+        }
+    }
+    if planned.is_empty() {
+        bail!(
+            "{}: no route between landmarks that stand for rocks ({} legs, {} landmarks with rocks)",
+            args.run.display(),
+            graph.legs.len(),
+            usable.len()
+        );
+    }
+    let terrain = Terrain {
+        world: &world,
+        calib: &calib,
+        landmark_rocks: &landmark_rocks,
+    };
+    let settings = qrm_vision::run::RunSettings::default();
+    let bar = super::simulate::progress(planned.len() as u64, "routes followed");
+    let trials: Vec<RouteTrial> = planned
+        .par_iter()
+        .enumerate()
+        .filter_map(|(k, path)| {
+            let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+            rng.set_stream(k as u64 + 1);
+            let trial = follow_route(&terrain, &known, &settings, &graph, path, &ids, &mut rng);
+            bar.inc(1);
+            trial
+        })
+        .collect();
+    bar.finish_and_clear();
+
+    // Route outcomes of the two rovers (qrm_synth::directions_trial).
+    let outcome = |identified: bool| -> Vec<Followed> {
+        trials
+            .iter()
+            .map(|t| Followed {
+                predicted: t.predicted,
+                legs: t.legs.len(),
+                succeeded: if identified {
+                    t.succeeded_identified
+                } else {
+                    t.succeeded
+                },
+            })
+            .collect()
+    };
+    let (literal, identified) = (outcome(false), outcome(true));
+    let scores = |followed: &[Followed]| {
+        let n = followed.len() as f64;
+        let measured = followed.iter().filter(|f| f.succeeded).count() as f64 / n;
+        let brier = followed
+            .iter()
+            .map(|f| (f.predicted - f64::from(u8::from(f.succeeded))).powi(2))
+            .sum::<f64>()
+            / n;
+        (measured, brier, calibration_bins(followed, 10))
+    };
+    let predicted = literal.iter().map(|f| f.predicted).sum::<f64>() / literal.len() as f64;
+    let (measured_literal, brier_literal, bins_literal) = scores(&literal);
+    let (measured_identified, brier_identified, bins_identified) = scores(&identified);
+    let legs: Vec<&qrm_synth::directions_trial::LegTrial> =
+        trials.iter().flat_map(|t| &t.legs).collect();
+    let errors: Vec<f64> = legs
+        .iter()
+        .flat_map(|l| l.range_log_errors.iter().copied())
+        .collect();
+    let mean_error = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
+    let sigma = (errors.iter().map(|e| (e - mean_error).powi(2)).sum::<f64>()
+        / errors.len().max(1) as f64)
+        .sqrt();
+    // Legs that hold in truth: selection by scene size, against the model.
+    let by_objects = |identified: bool| -> Vec<(usize, usize, usize)> {
+        (2..=args.scene)
+            .map(|objects| {
+                let these: Vec<_> = legs
+                    .iter()
+                    .filter(|l| l.holds && l.objects == objects)
+                    .collect();
+                let correct = these
+                    .iter()
+                    .filter(|l| {
+                        if identified {
+                            l.correct_identified
+                        } else {
+                            l.correct
+                        }
+                    })
+                    .count();
+                (objects, correct, these.len())
+            })
+            .filter(|&(_, _, count)| count > 0)
+            .collect()
+    };
+    let leg_count = legs.len().max(1) as f64;
+    let leg_predicted = legs.iter().map(|l| l.predicted).sum::<f64>() / leg_count;
+    let leg_literal = legs.iter().filter(|l| l.correct).count() as f64 / leg_count;
+    let leg_identified = legs.iter().filter(|l| l.correct_identified).count() as f64 / leg_count;
+    let leg_outcomes: Vec<Followed> = legs
+        .iter()
+        .map(|l| Followed {
+            predicted: l.predicted,
+            legs: 1,
+            succeeded: l.correct_identified,
+        })
+        .collect();
+    let leg_bins = calibration_bins(&leg_outcomes, 10);
+    let by_json = |rows: Vec<(usize, usize, usize)>| {
+        rows.iter()
+            .map(|&(o, c, t)| json!({"objects": o, "correct": c, "legs": t}))
+            .collect::<Vec<_>>()
+    };
+    let summary = json!({
+        "format": "qrm-directions-trials",
+        "version": 1,
+        "world": origin,
+        "run": args.run,
+        "criterion": args.criterion.criterion(),
+        "range_error_planned": args.range_error,
+        "range_error_measured": {"sd": sigma, "mean": mean_error, "detections": errors.len()},
+        "legs_in_map": graph.legs.len(),
+        "legs_proven": graph.legs.iter().filter(|l| l.is_proven()).count(),
+        "realizations": sampled.realizations,
+        "routes": trials.len(),
+        "mean_predicted": predicted,
+        "identified": {"measured": measured_identified, "brier": brier_identified, "bins": bins_identified},
+        "literal": {"measured": measured_literal, "brier": brier_literal, "bins": bins_literal},
+        "legs": {
+            "count": legs.len(),
+            "mean_predicted": leg_predicted,
+            "measured_identified": leg_identified,
+            "measured_literal": leg_literal,
+            "holding_in_truth": legs.iter().filter(|l| l.holds).count(),
+            "target_seen": legs.iter().filter(|l| l.target_seen).count(),
+            "target_identified": legs.iter().filter(|l| l.target_identified).count(),
+            "bins_identified": leg_bins,
+            "by_objects_holding_identified": by_json(by_objects(true)),
+            "by_objects_holding_literal": by_json(by_objects(false)),
+        },
+        "seconds": started.elapsed().as_secs_f64(),
+    });
+    let picture = ReliabilityPicture {
+        title: format!(
+            "Directions followed through rendered panoramas ({origin}); legs planned with σ = {}, measured σ = {:.2}",
+            args.range_error, sigma
+        ),
+        selection: [(true, "identified"), (false, "literal")]
+            .into_iter()
+            .map(|(identified, name)| SelectionSeries {
+                label: if identified {
+                    format!(
+                        "identified rover, legs that hold in truth (dots); Eq. (1) at σ = {sigma:.2} (line)"
+                    )
+                } else {
+                    format!("{name} rover, legs that hold in truth")
+                },
+                measured: by_objects(identified)
+                    .iter()
+                    .map(|&(o, c, t)| (o as f64, c as f64 / t as f64))
+                    .collect(),
+                fitted: if identified {
+                    (2..=args.scene)
+                        .map(|o| (o as f64, ReliabilityModel::ROVER.reliability(o, sigma)))
+                        .collect()
+                } else {
+                    Vec::new()
+                },
+            })
+            .collect(),
+        calibration: vec![
+            CalibrationSeries {
+                label: "identified rover, legs (count per bin, 95 % interval)".into(),
+                points: points(&leg_bins),
+            },
+            CalibrationSeries {
+                label: "identified rover, whole routes".into(),
+                points: points(&bins_identified),
+            },
+        ],
+        calibration_title: format!(
+            "(b) {} legs of {} {:?} routes",
+            legs.len(),
+            trials.len(),
+            args.criterion.criterion()
+        ),
+    };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut outputs = OutputSet::new();
+    for (name, value) in [
+        ("trials.json", serde_json::to_value(&trials)?),
+        ("summary.json", summary.clone()),
+    ] {
+        let path = args.out.join(name);
+        outputs
+            .stage_bytes(
+                &path,
+                (serde_json::to_string_pretty(&value)? + "\n").as_bytes(),
+            )
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let figure = args.out.join("calibration.png");
+    if picture.selection.iter().any(|s| !s.measured.is_empty()) {
+        outputs.stage(&figure, |t| write_reliability(t, &picture))?;
+    } else {
+        eprintln!("note: no leg holds in truth: no calibration.png");
+        outputs.remove_stale(&figure);
+    }
+    outputs
+        .commit()
+        .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
+    println!("{}", serde_json::to_string_pretty(&summary)?);
     Ok(())
 }

@@ -7,6 +7,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use qrm_atomic_file::OutputSet;
+use qrm_core::edc::Edc;
 use qrm_core::geometry::Point;
 use qrm_core::map::LandmarkId;
 use qrm_core::navigation::{RouteCost, RouteGraph};
@@ -16,13 +17,14 @@ use qrm_synth::closed_loop::{drive, Driving, Outcome, Terrain, Trip, CLEARANCE_M
 use qrm_synth::dataset::{Counts, Preset};
 use qrm_synth::{Pose, World};
 use qrm_vision::calib::Calibration;
+use qrm_vision::localization::KnownMap;
 use qrm_vision::run::RunSettings;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct DriveArgs {
@@ -64,50 +66,8 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     if !(args.lambda >= 0.0 && args.lambda.is_finite()) {
         bail!("--lambda {} must be a finite number ≥ 0", args.lambda);
     }
-    let truth = super::eval::read_truth(&args.images.join("truth.json"))?;
-    if truth.variant.is_some() {
-        bail!(
-            "{}: a set rendered with variations (stress, scene or camera options) cannot be rendered again here; use a plain preset",
-            args.images.display()
-        );
-    }
-    let preset = [Preset::Marsyard, Preset::Random, Preset::SparseLarge]
-        .into_iter()
-        .find(|p| p.name() == truth.preset)
-        .with_context(|| format!("unknown preset {:?} in the truth file", truth.preset))?;
-    let calib = Calibration::load(&args.images.join("calib.toml"))?;
-    let layout = preset.layout(
-        truth.seed,
-        Counts {
-            rocks: Some(truth.rocks.len()),
-            stations: Some(truth.stations.len()),
-        },
-    );
-    let world = World::generate(truth.seed, &layout.rocks);
-    if world.rocks.iter().zip(&truth.rocks).any(|(r, t)| {
-        r.position
-            .distance(Point::new(t.position[0], t.position[1]))
-            > 1e-9
-    }) {
-        bail!(
-            "{}: the world rendered again from preset {} seed {} is not the one in its truth file",
-            args.images.display(),
-            truth.preset,
-            truth.seed
-        );
-    }
-    let known = load_run(&args.run.join("map.json"))?;
-    let landmark_rocks = read_landmark_rocks(&args.run)?;
-    if let Some((l, r)) = landmark_rocks
-        .iter()
-        .find(|(_, &r)| r as usize >= world.rocks.len())
-    {
-        bail!(
-            "{}: landmark {l} stands for rock {r}, which {} does not have: not the run of this dataset",
-            args.run.join("eval.json").display(),
-            args.images.display()
-        );
-    }
+    let (calib, world, origin) = rendered_world(&args.images)?;
+    let (known, landmark_rocks) = run_of(&args.run, &world, &args.images)?;
     let rng_estimate = estimate(&known.map).expect("EDC has a lune");
     let graph = RouteGraph::new(known.map.landmarks(), &rng_estimate);
     let goals: Vec<LandmarkId> = landmark_rocks.keys().copied().collect();
@@ -204,11 +164,9 @@ pub fn run(args: &DriveArgs) -> Result<()> {
         .commit()
         .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
     println!(
-        "{} trips in {} (preset {}, seed {}), map of {} landmarks from {}:",
+        "{} trips in {} ({origin}), map of {} landmarks from {}:",
         trips.len(),
         args.images.display(),
-        truth.preset,
-        truth.seed,
         known.map.len(),
         args.run.display()
     );
@@ -358,4 +316,67 @@ fn figure(
             .collect(),
         side,
     }
+}
+
+/// The world of a synthetic dataset, rendered again from the preset and seed its truth.json
+/// names (checked against the rocks it lists), its camera, and "preset P, seed S".
+pub(super) fn rendered_world(images: &Path) -> Result<(Calibration, World, String)> {
+    let truth = super::eval::read_truth(&images.join("truth.json"))?;
+    if truth.variant.is_some() {
+        bail!(
+            "{}: a set rendered with variations (stress, scene or camera options) cannot be rendered again here; use a plain preset",
+            images.display()
+        );
+    }
+    let preset = [Preset::Marsyard, Preset::Random, Preset::SparseLarge]
+        .into_iter()
+        .find(|p| p.name() == truth.preset)
+        .with_context(|| format!("unknown preset {:?} in the truth file", truth.preset))?;
+    let calib = Calibration::load(&images.join("calib.toml"))?;
+    let layout = preset.layout(
+        truth.seed,
+        Counts {
+            rocks: Some(truth.rocks.len()),
+            stations: Some(truth.stations.len()),
+        },
+    );
+    let world = World::generate(truth.seed, &layout.rocks);
+    if world.rocks.iter().zip(&truth.rocks).any(|(r, t)| {
+        r.position
+            .distance(Point::new(t.position[0], t.position[1]))
+            > 1e-9
+    }) {
+        bail!(
+            "{}: the world rendered again from preset {} seed {} is not the one in its truth file",
+            images.display(),
+            truth.preset,
+            truth.seed
+        );
+    }
+    Ok((
+        calib,
+        world,
+        format!("preset {}, seed {}", truth.preset, truth.seed),
+    ))
+}
+
+/// The map of a run over `images`' world, and the rock each landmark stands for (eval.json).
+pub(super) fn run_of(
+    run: &Path,
+    world: &World,
+    images: &Path,
+) -> Result<(KnownMap<Edc>, BTreeMap<LandmarkId, u32>)> {
+    let known = load_run(&run.join("map.json"))?;
+    let landmark_rocks = read_landmark_rocks(run)?;
+    if let Some((l, r)) = landmark_rocks
+        .iter()
+        .find(|(_, &r)| r as usize >= world.rocks.len())
+    {
+        bail!(
+            "{}: landmark {l} stands for rock {r}, which {} does not have: not the run of this dataset",
+            run.join("eval.json").display(),
+            images.display()
+        );
+    }
+    Ok((known, landmark_rocks))
 }

@@ -51,6 +51,12 @@ pub enum NavigateCommand {
     /// and drive.png (000 Fig. 6 with the first three trips), e.g. `navigate drive --images
     /// data/marsyard --run marsyard-run --trips 20`.
     Drive(super::drive::DriveArgs),
+    /// Route directions (docs/DIRECTIONS.md) followed through panoramas rendered in a synthetic
+    /// dataset's world: routes planned on the map of a `pipeline run` over it, each leg's
+    /// target picked as the most isolated of the rover's own detections; predicted route
+    /// reliability against the measured success. Writes trials.json, summary.json and
+    /// calibration.png, e.g. `navigate directions --images data/marsyard --run marsyard-run`.
+    Directions(super::directions::TrialArgs),
     /// Simulated navigation with an ideal sensor (bearings and range order of the landmarks,
     /// no rendering): random fields, random start/goal pairs, the leg follower of 000 §VII-B
     /// planning on the true RNG or on the RNG of a map after `--images` simulated panoramas.
@@ -152,6 +158,7 @@ pub fn run_command(command: NavigateCommand) -> Result<()> {
         NavigateCommand::Simulate(args) => simulate(&args),
         NavigateCommand::Locate(args) => super::locate::locate(&args),
         NavigateCommand::Drive(args) => super::drive::run(&args),
+        NavigateCommand::Directions(args) => super::directions::trial(&args),
     }
 }
 

@@ -148,6 +148,7 @@ mod tests {
             noise: ViewNoise {
                 bearing_sd: 0.0,
                 range_sd: 0.0,
+                standoff: 0.0,
             },
             model: ReliabilityModel::FIG_30,
             criterion: Criterion::Compromise,

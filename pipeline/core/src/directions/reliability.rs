@@ -8,9 +8,10 @@
 //!
 //! For a rover the selection is simulated ([`selection_rate`]): it stands near landmark `R`
 //! (anywhere within half the distance to `R`'s nearest landmark, so inside `R`'s Voronoi
-//! cell), perceives every landmark's bearing with Gaussian error and its range with a
-//! log-normal relative error `σ`, takes `R` and its `n − 1` perceived nearest landmarks as the
-//! scene, and heads for the scene's most isolated member; it succeeds when that is the one the
+//! cell), perceives every other landmark's bearing with Gaussian error and its range with a
+//! log-normal relative error `σ`, takes itself for `R` (the rock at its feet is not seen in a
+//! panorama) and, with its `n − 1` perceived nearest landmarks, as the scene, and heads for
+//! the scene's most isolated member; it succeeds when that is the one the
 //! map-maker meant (the most isolated of the true scene). Eq. (1) is then fitted by least
 //! squares over `n` and `σ` ([`ReliabilityModel::fit`]).
 
@@ -44,14 +45,14 @@ impl ReliabilityModel {
         d: 0.7379,
     };
 
-    /// The fit for this project's rover: [`selection_rate`] with bearing error s.d. 0.5° over
-    /// `n = 2..=8` and `σ ∈ {0.05, 0.1, 0.2, 0.3}` (20 000 trials each, seed 1), as printed by
-    /// `pipeline simulate directions` (docs/DIRECTIONS.md).
+    /// The fit for this project's rover: [`selection_rate`] with bearing error s.d. 0.5° and
+    /// standoff 1 over `n = 2..=8` and `σ ∈ {0.05, 0.1, 0.2, 0.3}` (20 000 trials each, seed 1),
+    /// as printed by `pipeline simulate directions` (docs/DIRECTIONS.md).
     pub const ROVER: ReliabilityModel = ReliabilityModel {
-        a: 1.8599,
-        b: 0.8385,
-        c: 2.2531,
-        d: 0.5842,
+        a: 1.3435,
+        b: 0.9019,
+        c: 1.3128,
+        d: 0.3303,
     };
 
     /// `R(n, σ)` for a scene of `objects` (counting the reference).
@@ -97,6 +98,10 @@ pub struct ViewNoise {
     pub bearing_sd: f64,
     /// Standard deviation of `ln(measured range / true range)` (Eq. (1)'s σ).
     pub range_sd: f64,
+    /// How far from `R` the rover may stand, taking its own position for `R`'s: a fraction of
+    /// half the distance from `R` to its nearest landmark (1: anywhere in that disc, which
+    /// lies in `R`'s Voronoi cell; 0: on `R`).
+    pub standoff: f64,
 }
 
 /// How often the intended landmark was selected in one setting.
@@ -140,8 +145,9 @@ pub fn most_isolated_seen(seen: &[Point], at: usize, objects: usize) -> Option<u
 }
 
 /// Where a rover standing near landmark `at` of `world` perceives every landmark: from a point
-/// uniform in the disc of half the distance to `at`'s nearest landmark, bearings and ranges
-/// with `noise`.
+/// uniform in the disc of `noise.standoff` times half the distance to `at`'s nearest landmark,
+/// bearings and ranges with `noise`. The rock it stands at is not seen (too near the camera, as in rendered
+/// panoramas): the rover takes its own position for it.
 pub fn perceive(world: &[Point], at: usize, noise: ViewNoise, rng: &mut impl Rng) -> Vec<Point> {
     let nearest = world
         .iter()
@@ -149,7 +155,7 @@ pub fn perceive(world: &[Point], at: usize, noise: ViewNoise, rng: &mut impl Rng
         .filter(|&(i, _)| i != at)
         .map(|(_, p)| p.distance(world[at]))
         .fold(f64::INFINITY, f64::min);
-    let radius = 0.5 * nearest * rng.random::<f64>().sqrt();
+    let radius = 0.5 * noise.standoff * nearest * rng.random::<f64>().sqrt();
     let angle = rng.random::<f64>() * std::f64::consts::TAU;
     let rover = Point::new(
         world[at].x + radius * angle.cos(),
@@ -159,7 +165,11 @@ pub fn perceive(world: &[Point], at: usize, noise: ViewNoise, rng: &mut impl Rng
     let range = Normal::new(0.0, noise.range_sd).expect("a finite s.d. ≥ 0");
     world
         .iter()
-        .map(|p| {
+        .enumerate()
+        .map(|(i, p)| {
+            if i == at {
+                return rover;
+            }
             let v = *p - rover;
             let theta = v.y.atan2(v.x) + bearing.sample(rng);
             let r = v.x.hypot(v.y) * range.sample(rng).exp();
@@ -253,6 +263,7 @@ mod tests {
         let exact = ViewNoise {
             bearing_sd: 0.0,
             range_sd: 0.0,
+            standoff: 0.0,
         };
         for objects in 2..=6 {
             assert_eq!(selection_rate(objects, exact, 200, 3).successes, 200);
@@ -269,6 +280,7 @@ mod tests {
                 let noise = ViewNoise {
                     bearing_sd: 0.5f64.to_radians(),
                     range_sd,
+                    standoff: 1.0,
                 };
                 selection_rate(objects, noise, 4000, 7)
             })
