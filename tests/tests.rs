@@ -10,5 +10,6 @@ mod fdc_tables;
 mod feasibility;
 mod map;
 mod measurement;
+mod probabilistic_tables;
 mod simulation;
 mod synth;

@@ -57,4 +57,5 @@ pub mod measurement;
 pub mod metrics;
 pub mod navigation;
 pub mod neighborhood;
+pub mod probabilistic;
 pub mod simulation;
