@@ -1536,6 +1536,16 @@ fn directions_cases() -> Vec<Case> {
         )
         .setup(maps),
         Case::new(
+            "simulate probabilistic: no scenarios",
+            "simulate probabilistic --scenarios 0 --out {dir}/p",
+            &["--scenarios"],
+        ),
+        Case::new(
+            "simulate probabilistic: no bearing noise (the sampler needs some)",
+            "simulate probabilistic --bearing-noise 0 --out {dir}/p",
+            &["--bearing-noise"],
+        ),
+        Case::new(
             "simulate directions: no trials",
             "simulate directions --trials 0 --out {dir}/study",
             &["--trials and --routes must be positive"],

@@ -9,6 +9,7 @@ pub mod measure;
 pub mod navigate;
 pub mod output;
 pub mod pictures;
+pub mod probabilistic;
 pub mod rng_picture;
 pub mod run;
 pub mod simulate;

@@ -39,6 +39,10 @@ pub enum SimulateCommand {
     /// perception against their predicted reliability. Writes reliability.json and
     /// reliability.png (docs/DIRECTIONS.md).
     Directions(super::directions::DirectionsStudyArgs),
+    /// 002's Table I (Mor & Indelman): random triplets seen from three camera poses with
+    /// noisy bearings and motion, estimated by the full, fast and baseline probabilistic
+    /// algorithms; DMSE, gmd and entropy percentiles printed beside the paper's.
+    Probabilistic(super::probabilistic::ProbabilisticArgs),
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -139,6 +143,7 @@ pub fn run_command(command: SimulateCommand) -> Result<()> {
     match command {
         SimulateCommand::Montecarlo(args) => montecarlo(args),
         SimulateCommand::Directions(args) => super::directions::study(&args),
+        SimulateCommand::Probabilistic(args) => super::probabilistic::run(&args),
         SimulateCommand::Single(args) => match args.calculus {
             CalculusName::Edc => single::<Edc>(&args),
             CalculusName::Fdc => single::<Fdc>(&args),

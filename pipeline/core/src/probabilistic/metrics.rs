@@ -47,12 +47,14 @@ pub fn gmd(belief: &Belief, truth: u8, centroids: &RegionCentroids) -> f64 {
 
 /// `−Σ p ln p`, nats (002 leaves the base open: ln 20 = 3.00 nats for the uniform belief).
 pub fn entropy(belief: &Belief) -> f64 {
-    -belief
+    let sum: f64 = belief
         .probabilities()
         .iter()
         .filter(|&&p| p > 0.0)
         .map(|&p| p * p.ln())
-        .sum::<f64>()
+        .sum();
+    // A point mass sums to −0 (or a rounding hair below 0 nats).
+    (-sum).max(0.0)
 }
 
 #[cfg(test)]

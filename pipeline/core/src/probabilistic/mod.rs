@@ -4,8 +4,11 @@
 
 mod belief;
 mod metrics;
+pub mod study;
 mod tensor;
+mod triplet;
 
 pub use belief::{Belief, STATES};
 pub use metrics::{dmse, entropy, gmd, gt_rating, Rating};
 pub use tensor::{CompositionTensor, RegionCentroids, TableError};
+pub use triplet::{estimate_baseline, estimate_fast, estimate_full, Noise, Prior, View};

@@ -1,0 +1,166 @@
+//! `pipeline simulate probabilistic`: 002's Table I (Mor & Indelman, §IV) — random triplets
+//! seen from three camera poses, estimated by the full, fast and baseline algorithms of
+//! `qrm_core::probabilistic`, printed beside the paper's percentiles.
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use qrm_atomic_file::OutputSet;
+use qrm_core::probabilistic::study::{quartiles, run_study, Outcome, Score, StudySettings};
+use qrm_core::probabilistic::Noise;
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Args, Debug)]
+pub struct ProbabilisticArgs {
+    /// Random triplets (002: 300).
+    #[arg(long, default_value_t = 300)]
+    scenarios: usize,
+    /// Bearing noise s.d., degrees (002 Table I: 3).
+    #[arg(long, default_value_t = 3.0)]
+    bearing_noise: f64,
+    /// Motion-command noise s.d., degrees (002 Table I: 7).
+    #[arg(long, default_value_t = 7.0)]
+    motion_noise: f64,
+    #[arg(long, default_value_t = 4000)]
+    full_particles: usize,
+    #[arg(long, default_value_t = 300)]
+    fast_particles: usize,
+    /// Pose/ray samples per view of the baseline.
+    #[arg(long, default_value_t = 2000)]
+    baseline_samples: usize,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output directory: table1.json, outcomes.json.
+    #[arg(long, default_value = "probabilistic")]
+    out: PathBuf,
+}
+
+/// 002 Table I: 25th / 50th / 75th percentiles (DMSE, gmd, entropy) and median seconds
+/// (MATLAB), per algorithm (baseline, full, fast).
+const PAPER: [(&str, [[f64; 3]; 3], f64); 3] = [
+    (
+        "baseline",
+        [[0.39, 0.63, 0.71], [0.28, 1.10, 2.30], [0.28, 0.66, 0.87]],
+        26.0,
+    ),
+    (
+        "full",
+        [[0.0, 0.16, 0.63], [0.0, 0.25, 1.15], [0.0, 5e-3, 0.58]],
+        18.0,
+    ),
+    (
+        "fast",
+        [[0.0, 0.21, 0.62], [0.0, 0.27, 1.16], [0.0, 0.07, 0.64]],
+        0.05,
+    ),
+];
+
+pub fn run(args: &ProbabilisticArgs) -> Result<()> {
+    if args.scenarios == 0 || args.full_particles == 0 || args.fast_particles == 0 {
+        bail!("--scenarios and the particle counts must be positive");
+    }
+    let within = |value: f64, most: f64| value > 0.0 && value <= most;
+    if !(within(args.bearing_noise, 30.0) && within(args.motion_noise, 60.0)) {
+        bail!("--bearing-noise must be in (0, 30] and --motion-noise in (0, 60] degrees");
+    }
+    let settings = StudySettings {
+        scenarios: args.scenarios,
+        views: 3,
+        noise: Noise {
+            bearing: args.bearing_noise.to_radians(),
+            motion: args.motion_noise.to_radians(),
+        },
+        full_particles: args.full_particles,
+        fast_particles: args.fast_particles,
+        baseline_samples: args.baseline_samples,
+        seed: args.seed,
+    };
+    let started = Instant::now();
+    let bar = super::simulate::progress(args.scenarios as u64, "triplets");
+    let outcomes = run_study(&settings, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let pick = |k: usize, o: &Outcome| -> Score {
+        match k {
+            0 => o.baseline,
+            1 => o.full,
+            _ => o.fast,
+        }
+    };
+    let mut rows = Vec::new();
+    println!(
+        "002 Table I: {} triplets, 3 views, bearing noise {}°, motion noise {}° (25th / median / 75th percentile; paper in brackets)",
+        args.scenarios, args.bearing_noise, args.motion_noise
+    );
+    println!(
+        "{:<9} {:<34} {:<34} {:<34} {:>12}",
+        "", "DMSE", "gmd (|AB| units)", "entropy (nats)", "median time"
+    );
+    for (k, (name, paper, paper_seconds)) in PAPER.iter().enumerate() {
+        let metric = |m: usize| {
+            let mut v: Vec<f64> = outcomes
+                .iter()
+                .map(|o| {
+                    let s = pick(k, o);
+                    [s.dmse, s.gmd, s.entropy][m]
+                })
+                .collect();
+            quartiles(&mut v)
+        };
+        let ours = [metric(0), metric(1), metric(2)];
+        let mut seconds: Vec<f64> = outcomes.iter().map(|o| pick(k, o).seconds).collect();
+        let median_seconds = quartiles(&mut seconds)[1];
+        let failed = outcomes.iter().filter(|o| pick(k, o).failed).count();
+        let cell = |m: usize| {
+            format!(
+                "{:.2} {:.2} {:.2} [{} {} {}]",
+                ours[m][0], ours[m][1], ours[m][2], paper[m][0], paper[m][1], paper[m][2]
+            )
+        };
+        println!(
+            "{name:<9} {:<34} {:<34} {:<34} {:>9.2} ms [{paper_seconds} s MATLAB]",
+            cell(0),
+            cell(1),
+            cell(2),
+            median_seconds * 1e3
+        );
+        rows.push(json!({
+            "algorithm": name,
+            "dmse": ours[0], "gmd": ours[1], "entropy_nats": ours[2],
+            "paper": {"dmse": paper[0], "gmd": paper[1], "entropy": paper[2], "median_seconds": paper_seconds},
+            "median_seconds": median_seconds,
+            "failed": failed,
+        }));
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut outputs = OutputSet::new();
+    let table = json!({
+        "format": "qrm-probabilistic-table1",
+        "version": 1,
+        "settings": settings,
+        "rows": rows,
+        "seconds": started.elapsed().as_secs_f64(),
+    });
+    for (name, value) in [
+        ("table1.json", table),
+        ("outcomes.json", serde_json::to_value(&outcomes)?),
+    ] {
+        let path = args.out.join(name);
+        outputs
+            .stage_bytes(
+                &path,
+                (serde_json::to_string_pretty(&value)? + "\n").as_bytes(),
+            )
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    outputs
+        .commit()
+        .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
+    println!(
+        "wrote {} ({:.1} s)",
+        args.out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}

@@ -1,0 +1,361 @@
+//! Qualitative estimation of one triplet `A, B, C` from bearings seen at a few camera poses
+//! (002 §III; seed digest C.2–C.4, C.7), in the frame `A = (0,0)`, `B = (0,1)`.
+//!
+//! - [`estimate_full`]: the sampling algorithm (002 Algorithm 1). Each particle draws the
+//!   first pose on the inscribed-angle locus of a noisy subtended angle `γ' ~ N(γ, 2σ_v²)`,
+//!   each later pose where the ray of a noisy motion command meets that step's locus, then
+//!   resects `C` (the centroid of the pairwise intersections of its bearing rays) and is
+//!   weighted by the likelihood of `C`'s bearings. The belief is the weighted histogram of
+//!   `C`'s region (Eq. 9).
+//! - [`estimate_fast`]: 002 §III-D, "sampling only for the prior, noise neglected": the first
+//!   pose along the exact locus, later poses and `C` by exact intersection; particles are
+//!   still weighted by `C`'s bearings (without that, every pose on the first locus would count
+//!   alike and the belief would not be "very close to the full one", as 002 reports).
+//! - [`estimate_baseline`]: 002 §III-F, after Padgett & Campbell: each view alone (pose on its
+//!   locus, `C` anywhere along its bearing ray within the prior's support), views multiplied
+//!   as if independent.
+
+use super::belief::{Belief, STATES};
+use crate::edc;
+use crate::geometry::Point;
+use rand::Rng;
+use rand_distr::{Distribution, Normal};
+use std::f64::consts::{PI, TAU};
+
+/// One view of the triplet: bearings of `A`, `B`, `C` relative to the camera's heading
+/// (radians), and the motion command that led here from the previous view (heading of the
+/// displacement relative to the previous camera frame; `None` for the first view).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    pub bearings: [f64; 3],
+    pub motion: Option<f64>,
+}
+
+/// Noise the estimators assume: bearing and motion-command s.d., radians.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Noise {
+    pub bearing: f64,
+    pub motion: f64,
+}
+
+/// Where `C` may lie a priori, in the AB frame (002 leaves it open; seed digest C.7: the
+/// simulation box mapped into the frame): a convex polygon, counter-clockwise.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prior {
+    pub polygon: Vec<Point>,
+}
+
+impl Prior {
+    /// The parameter interval `[t0, t1]` (t ≥ 0) of the ray `origin + t·dir` inside the polygon.
+    fn clip(&self, origin: Point, dir: Point) -> Option<(f64, f64)> {
+        let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+        let n = self.polygon.len();
+        for i in 0..n {
+            let (a, b) = (self.polygon[i], self.polygon[(i + 1) % n]);
+            // Inside: cross(b − a, p − a) ≥ 0, linear in t.
+            let f0 = (b.x - a.x) * (origin.y - a.y) - (b.y - a.y) * (origin.x - a.x);
+            let df = (b.x - a.x) * dir.y - (b.y - a.y) * dir.x;
+            if df.abs() < 1e-15 {
+                if f0 < 0.0 {
+                    return None;
+                }
+            } else if df > 0.0 {
+                t0 = t0.max(-f0 / df);
+            } else {
+                t1 = t1.min(-f0 / df);
+            }
+        }
+        (t0 < t1 && t1.is_finite()).then_some((t0, t1))
+    }
+}
+
+const A: Point = Point::new(0.0, 0.0);
+const B: Point = Point::new(0.0, 1.0);
+
+fn wrap(angle: f64) -> f64 {
+    (angle + PI).rem_euclid(TAU) - PI
+}
+
+fn direction(angle: f64) -> Point {
+    Point::new(angle.cos(), angle.sin())
+}
+
+fn angle_to(from: Point, to: Point) -> f64 {
+    (to.y - from.y).atan2(to.x - from.x)
+}
+
+/// The signed angle at `x` from the direction of `A` to that of `B`.
+fn subtended(x: Point) -> f64 {
+    wrap(angle_to(x, B) - angle_to(x, A))
+}
+
+/// The circle of the inscribed-angle locus of `gamma` (the arc where [`subtended`] is
+/// `gamma`): centre `(−cot(γ)/2, 1/2)`, radius `1/(2|sin γ|)`. For `γ > 0` the camera is left
+/// of `AB`; the centre is on its side when the angle is acute (the major arc), across `AB`
+/// when obtuse.
+fn locus_circle(gamma: f64) -> Option<(Point, f64)> {
+    let s = gamma.sin();
+    if s.abs() < 1e-9 {
+        return None;
+    }
+    Some((Point::new(-0.5 * gamma.cos() / s, 0.5), 0.5 / s.abs()))
+}
+
+/// A point of the locus of `gamma`, at the circle parameter `t` if it lies on the locus arc.
+fn locus_point(gamma: f64, t: f64) -> Option<Point> {
+    let (c, r) = locus_circle(gamma)?;
+    let x = Point::new(c.x + r * t.cos(), c.y + r * t.sin());
+    ((subtended(x) - gamma).abs() < 1e-6).then_some(x)
+}
+
+/// Where the ray `origin + s·dir` (s > 0) meets the locus arc of `gamma`.
+fn ray_meets_locus(origin: Point, dir: Point, gamma: f64) -> Vec<Point> {
+    let Some((c, r)) = locus_circle(gamma) else {
+        return Vec::new();
+    };
+    let o = origin - c;
+    let b = o.x * dir.x + o.y * dir.y;
+    let q = o.x * o.x + o.y * o.y - r * r;
+    let disc = b * b - q;
+    if disc < 0.0 {
+        return Vec::new();
+    }
+    [-b - disc.sqrt(), -b + disc.sqrt()]
+        .into_iter()
+        .filter(|&s| s > 1e-9)
+        .map(|s| Point::new(origin.x + s * dir.x, origin.y + s * dir.y))
+        .filter(|&x| (subtended(x) - gamma).abs() < 1e-6)
+        .collect()
+}
+
+/// The camera heading at `x` that puts `A` at relative bearing `phi_a`.
+fn heading(x: Point, phi_a: f64) -> f64 {
+    wrap(angle_to(x, A) - phi_a)
+}
+
+/// `C` as the centroid of the pairwise intersections (in front of both cameras) of its bearing
+/// rays from `poses`; `None` if no pair meets.
+fn resect(poses: &[(Point, f64)], phi_c: &[f64]) -> Option<Point> {
+    let mut sum = (0.0, 0.0, 0usize);
+    for i in 0..poses.len() {
+        for j in i + 1..poses.len() {
+            let (p, q) = (poses[i].0, poses[j].0);
+            let (u, v) = (
+                direction(poses[i].1 + phi_c[i]),
+                direction(poses[j].1 + phi_c[j]),
+            );
+            let det = u.x * (-v.y) - u.y * (-v.x);
+            if det.abs() < 1e-12 {
+                continue;
+            }
+            let (dx, dy) = (q.x - p.x, q.y - p.y);
+            let s = (dx * (-v.y) - dy * (-v.x)) / det;
+            let t = (u.x * dy - u.y * dx) / det;
+            if s > 0.0 && t > 0.0 {
+                sum.0 += p.x + s * u.x;
+                sum.1 += p.y + s * u.y;
+                sum.2 += 1;
+            }
+        }
+    }
+    (sum.2 > 0).then(|| Point::new(sum.0 / sum.2 as f64, sum.1 / sum.2 as f64))
+}
+
+/// `ln` of the Gaussian likelihood of residual `x` (up to a constant).
+fn log_gaussian(x: f64, sd: f64) -> f64 {
+    -0.5 * (x / sd.max(1e-9)).powi(2)
+}
+
+/// One particle's path: poses from the locus of each view (sampled with `noise`, or exact),
+/// `C` resected, and the log-likelihood of `C`'s bearings at `bearing_sd`.
+fn particle(
+    views: &[View],
+    noise: Option<Noise>,
+    bearing_sd: f64,
+    rng: &mut impl Rng,
+) -> Option<(Point, f64)> {
+    let jitter = |sd: f64, rng: &mut dyn rand::RngCore| match noise {
+        Some(_) if sd > 0.0 => Normal::new(0.0, sd).expect("finite s.d.").sample(rng),
+        _ => 0.0,
+    };
+    let sd_gamma = noise.map_or(0.0, |n| n.bearing * 2f64.sqrt());
+    let sd_motion = noise.map_or(0.0, |n| n.motion);
+    let mut poses: Vec<(Point, f64)> = Vec::with_capacity(views.len());
+    for (k, view) in views.iter().enumerate() {
+        let gamma = wrap(view.bearings[1] - view.bearings[0]) + jitter(sd_gamma, rng);
+        let x = if k == 0 {
+            // A uniform circle parameter; off-arc draws are redrawn a few times.
+            (0..32).find_map(|_| locus_point(gamma, rng.random::<f64>() * TAU))?
+        } else {
+            let (previous, alpha) = poses[k - 1];
+            let psi = view.motion? + jitter(sd_motion, rng);
+            let hits = ray_meets_locus(previous, direction(alpha + psi), gamma);
+            *hits.get(rng.random_range(0..hits.len().max(1)))?
+        };
+        poses.push((x, heading(x, view.bearings[0])));
+    }
+    let phi_c: Vec<f64> = views.iter().map(|v| v.bearings[2]).collect();
+    let c = resect(&poses, &phi_c)?;
+    let log_weight = poses
+        .iter()
+        .zip(&phi_c)
+        .map(|(&(x, alpha), &phi)| log_gaussian(wrap(angle_to(x, c) - alpha - phi), bearing_sd))
+        .sum();
+    Some((c, log_weight))
+}
+
+/// The weighted histogram of `C`'s region over particles `(C, ln weight)`.
+fn histogram(samples: &[(Point, f64)]) -> Option<Belief> {
+    let top = samples
+        .iter()
+        .map(|s| s.1)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let mut weights = [0.0; STATES];
+    for &(c, log_w) in samples {
+        if let Some(r) = edc::classify(A, B, c) {
+            weights[r as usize - 1] += (log_w - top).exp();
+        }
+    }
+    Belief::from_weights(weights)
+}
+
+/// 002 Algorithm 1 with `particles` particles; `None` when no particle survives (no pose
+/// chain or no resection).
+pub fn estimate_full(
+    views: &[View],
+    noise: Noise,
+    particles: usize,
+    rng: &mut impl Rng,
+) -> Option<Belief> {
+    let samples: Vec<(Point, f64)> = (0..particles)
+        .filter_map(|_| particle(views, Some(noise), noise.bearing, rng))
+        .collect();
+    histogram(&samples)
+}
+
+/// 002 §III-D: the prior sampled along the exact first locus, everything else exact, the
+/// particles weighted by `C`'s bearings at `bearing_sd`.
+pub fn estimate_fast(
+    views: &[View],
+    bearing_sd: f64,
+    particles: usize,
+    rng: &mut impl Rng,
+) -> Option<Belief> {
+    let samples: Vec<(Point, f64)> = (0..particles)
+        .filter_map(|_| particle(views, None, bearing_sd, rng))
+        .collect();
+    histogram(&samples)
+}
+
+/// 002 §III-F: each view estimated alone — pose on its exact locus, `C` uniform along its
+/// bearing ray within `prior` — and the views' beliefs multiplied. A view whose rays all miss
+/// the prior is left out. Each view's histogram is floored at `1e-3` of its mass before the
+/// product, so that one view's empty state does not veto the others (002 does not say).
+pub fn estimate_baseline(
+    views: &[View],
+    prior: &Prior,
+    samples_per_view: usize,
+    rng: &mut impl Rng,
+) -> Option<Belief> {
+    let mut product = [1.0; STATES];
+    let mut used = 0;
+    for view in views {
+        let gamma = wrap(view.bearings[1] - view.bearings[0]);
+        let mut weights = [0.0; STATES];
+        for _ in 0..samples_per_view {
+            let Some(x) = (0..32).find_map(|_| locus_point(gamma, rng.random::<f64>() * TAU))
+            else {
+                continue;
+            };
+            let dir = direction(heading(x, view.bearings[0]) + view.bearings[2]);
+            if let Some((t0, t1)) = prior.clip(x, dir) {
+                let t = t0 + rng.random::<f64>() * (t1 - t0);
+                let c = Point::new(x.x + t * dir.x, x.y + t * dir.y);
+                if let Some(r) = edc::classify(A, B, c) {
+                    // Weighted by the ray's length inside the prior: uniform over the region
+                    // the view allows.
+                    weights[r as usize - 1] += t1 - t0;
+                }
+            }
+        }
+        let Some(view_belief) = Belief::from_weights(weights) else {
+            continue;
+        };
+        used += 1;
+        for (p, q) in product.iter_mut().zip(view_belief.probabilities()) {
+            *p *= q.max(1e-3 / STATES as f64);
+        }
+    }
+    if used == 0 {
+        return None;
+    }
+    Belief::from_weights(product)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    /// Views of `c` from `poses` (position, heading) with exact bearings.
+    fn views(c: Point, poses: &[(Point, f64)]) -> Vec<View> {
+        poses
+            .iter()
+            .enumerate()
+            .map(|(k, &(x, alpha))| View {
+                bearings: [A, B, c].map(|l| wrap(angle_to(x, l) - alpha)),
+                motion: (k > 0).then(|| {
+                    let (prev, prev_alpha) = poses[k - 1];
+                    wrap(angle_to(prev, x) - prev_alpha)
+                }),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_locus_holds_the_camera() {
+        let x = Point::new(1.3, -0.4);
+        let gamma = subtended(x);
+        let (c, r) = locus_circle(gamma).unwrap();
+        assert!((c.distance(x) - r).abs() < 1e-9);
+        let hits = ray_meets_locus(Point::new(3.0, -0.4), Point::new(-1.0, 0.0), gamma);
+        assert!(hits.iter().any(|h| h.distance(x) < 1e-9), "{hits:?}");
+    }
+
+    #[test]
+    fn exact_views_put_the_truth_first() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let c = Point::new(-1.2, 2.1);
+        let truth = edc::classify(A, B, c).unwrap();
+        let poses = [
+            (Point::new(1.5, -0.5), 0.3),
+            (Point::new(2.0, 1.5), 2.0),
+            (Point::new(-0.5, 3.5), -1.0),
+        ];
+        let v = views(c, &poses);
+        let fast = estimate_fast(&v, 0.5f64.to_radians(), 500, &mut rng).unwrap();
+        assert_eq!(fast.most_likely(), truth);
+        let full = estimate_full(
+            &v,
+            Noise {
+                bearing: 0.5f64.to_radians(),
+                motion: 1f64.to_radians(),
+            },
+            2000,
+            &mut rng,
+        )
+        .unwrap();
+        assert_eq!(full.most_likely(), truth);
+        let prior = Prior {
+            polygon: vec![
+                Point::new(-6.0, -6.0),
+                Point::new(6.0, -6.0),
+                Point::new(6.0, 6.0),
+                Point::new(-6.0, 6.0),
+            ],
+        };
+        let baseline = estimate_baseline(&v, &prior, 2000, &mut rng).unwrap();
+        assert!(baseline.probability(truth) > 0.0);
+    }
+}
