@@ -1,10 +1,9 @@
 //! `directions`: a route with its instructions, custom map and pictures from a run, from a
 //! converged simulated map (where the map proves the legs), and `simulate directions`.
 
+use super::navigate::{demo_run, DEMO};
 use super::pipeline;
 use std::path::Path;
-
-const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../datasets/demo");
 
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
@@ -16,18 +15,7 @@ fn json(path: &Path) -> serde_json::Value {
 #[test]
 fn directions_from_a_run_with_pictures() {
     let scratch = tempfile::tempdir().unwrap();
-    let run = scratch.path().join("run");
-    let o = pipeline(&[
-        "run",
-        "--images",
-        DEMO,
-        "--out",
-        run.to_str().unwrap(),
-        "--quiet",
-        "--panoramas",
-        "none",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let run = demo_run(scratch.path());
     let map = json(&run.join("map.json"));
     let ids: Vec<u64> = map["landmarks"]
         .as_array()
@@ -163,18 +151,7 @@ fn the_reliability_study_writes_its_figure() {
 #[test]
 fn directions_followed_through_rendered_panoramas() {
     let scratch = tempfile::tempdir().unwrap();
-    let run = scratch.path().join("run");
-    let o = pipeline(&[
-        "run",
-        "--images",
-        DEMO,
-        "--out",
-        run.to_str().unwrap(),
-        "--quiet",
-        "--panoramas",
-        "none",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let run = demo_run(scratch.path());
     let trial = |out: &str| {
         let out = scratch.path().join(out);
         let o = pipeline(&[

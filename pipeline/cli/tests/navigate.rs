@@ -164,7 +164,7 @@ fn simulates_navigation_and_writes_its_outputs() {
 }
 
 /// The demo set mapped (and scored) into `dir/run`.
-fn demo_run(dir: &Path) -> std::path::PathBuf {
+pub(super) fn demo_run(dir: &Path) -> std::path::PathBuf {
     let run = dir.join("run");
     let o = pipeline(&[
         "run",
@@ -180,7 +180,7 @@ fn demo_run(dir: &Path) -> std::path::PathBuf {
     run
 }
 
-const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../datasets/demo");
+pub(super) const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../datasets/demo");
 
 /// `navigate locate` places panoramas against a run's map: every cell it claims holds against
 /// the truth (a certain cell is the true one; a possible set holds it, or names a rock not

@@ -198,8 +198,8 @@ fn ordered(a: LandmarkId, b: LandmarkId) -> (LandmarkId, LandmarkId) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calculus::RelationSet;
     use crate::edc::Edc;
+    use crate::map::testing::converged;
     use crate::map::Observation;
 
     #[test]
@@ -211,24 +211,7 @@ mod tests {
             Point::new(1.0, 3.7),
             Point::new(5.2, 4.1),
         ];
-        let mut observations = Vec::new();
-        for a in 0..5u32 {
-            for b in 0..5u32 {
-                for c in 0..5u32 {
-                    if a != b && b != c && a != c {
-                        let r = Edc::classify(
-                            points[a as usize],
-                            points[b as usize],
-                            points[c as usize],
-                        )
-                        .expect("generic points");
-                        observations.push(Observation::new(a, b, c, RelationSet::single(r)));
-                    }
-                }
-            }
-        }
-        let mut map = Hypergraph::<Edc>::new();
-        map.fuse(&observations).expect("consistent");
+        let map = converged::<Edc>(&points);
         let est = estimate(&map).expect("EDC has a lune");
         assert!(est.edges.iter().all(|e| e.cost == 0.0));
         let cmp = compare(&map, &est, |id| points[id as usize]);

@@ -4,6 +4,7 @@
 //! checks predicted route reliability against simulated following.
 
 use super::map::{calculus_of, load, read};
+use super::output::stage_json;
 use super::pictures::crop_with_context;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
@@ -213,13 +214,7 @@ fn plan(map: &Hypergraph<Edc>, args: &DirectionsArgs) -> Result<Directions> {
         })
     };
     let (from, to) = (index(args.from)?, index(args.to)?);
-    let sampled = sampled_legs(map, args.scene, args.samples, args.seed);
-    let graph = LegGraph::from_legs(
-        sampled.legs,
-        ids.len(),
-        &ReliabilityModel::ROVER,
-        args.range_error,
-    );
+    let (graph, sampled) = rover_legs(map, args.scene, args.samples, args.seed, args.range_error);
     let Some(routes) = graph.routes(from, to) else {
         let reach = criteria::strongly_connected(&graph.arcs, graph.nodes())
             .into_iter()
@@ -281,6 +276,30 @@ fn plan(map: &Hypergraph<Edc>, args: &DirectionsArgs) -> Result<Directions> {
         criterion,
         steps,
     })
+}
+
+/// The legs of `map` — proven, and sampled from `samples` realizations — as a graph costed by
+/// the rover's reliability model at range error `sigma`; with the sampling's counts.
+fn rover_legs(
+    map: &Hypergraph<Edc>,
+    scene: usize,
+    samples: usize,
+    seed: u64,
+    sigma: f64,
+) -> (LegGraph, SampledRealizations) {
+    let sampled = sampled_legs(map, scene, samples, seed);
+    let counts = SampledRealizations {
+        realizations: sampled.realizations,
+        tried: sampled.tried,
+    };
+    let graph = LegGraph::from_legs(sampled.legs, map.len(), &ReliabilityModel::ROVER, sigma);
+    (graph, counts)
+}
+
+/// How many realizations the legs were sampled from, and how many were tried.
+struct SampledRealizations {
+    realizations: usize,
+    tried: usize,
 }
 
 fn route_names(d: &Directions, path: &Path) -> String {
@@ -864,13 +883,7 @@ pub fn study(args: &DirectionsStudyArgs) -> Result<()> {
         ),
     };
     let mut outputs = OutputSet::new();
-    let path = args.out.join("reliability.json");
-    outputs
-        .stage_bytes(
-            &path,
-            (serde_json::to_string_pretty(&value)? + "\n").as_bytes(),
-        )
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    stage_json(&mut outputs, &args.out.join("reliability.json"), &value)?;
     outputs.stage(&args.out.join("reliability.png"), |t| {
         write_reliability(t, &picture)
     })?;
@@ -986,13 +999,7 @@ pub fn trial(args: &TrialArgs) -> Result<()> {
     let (known, landmark_rocks) = super::drive::run_of(&args.run, &world, &args.images)?;
     let map = &known.map;
     let ids = map.landmarks().to_vec();
-    let sampled = sampled_legs(map, args.scene, args.samples, args.seed);
-    let graph = LegGraph::from_legs(
-        sampled.legs,
-        ids.len(),
-        &ReliabilityModel::ROVER,
-        args.range_error,
-    );
+    let (graph, sampled) = rover_legs(map, args.scene, args.samples, args.seed, args.range_error);
     let usable: Vec<usize> = (0..ids.len())
         .filter(|&i| landmark_rocks.contains_key(&ids[i]))
         .collect();
@@ -1208,18 +1215,12 @@ pub fn trial(args: &TrialArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let mut outputs = OutputSet::new();
-    for (name, value) in [
-        ("trials.json", serde_json::to_value(&trials)?),
-        ("summary.json", summary.clone()),
-    ] {
-        let path = args.out.join(name);
-        outputs
-            .stage_bytes(
-                &path,
-                (serde_json::to_string_pretty(&value)? + "\n").as_bytes(),
-            )
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
+    stage_json(
+        &mut outputs,
+        &args.out.join("trials.json"),
+        &serde_json::to_value(&trials)?,
+    )?;
+    stage_json(&mut outputs, &args.out.join("summary.json"), &summary)?;
     let figure = args.out.join("calibration.png");
     if picture.selection.iter().any(|s| !s.measured.is_empty()) {
         outputs.stage(&figure, |t| write_reliability(t, &picture))?;

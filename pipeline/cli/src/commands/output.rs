@@ -2,6 +2,7 @@
 //! (`qrm_atomic_file`), and errors name the file.
 
 use anyhow::{Context, Result};
+use qrm_atomic_file::OutputSet;
 use std::path::Path;
 
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
@@ -10,5 +11,13 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
             .with_context(|| format!("cannot create directory {}", dir.display()))?;
     }
     qrm_atomic_file::write_bytes(path, bytes)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Stages `value` as pretty JSON (with a final newline) at `path` in `outputs`.
+pub fn stage_json(outputs: &mut OutputSet, path: &Path, value: &serde_json::Value) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)? + "\n";
+    outputs
+        .stage_bytes(path, text.as_bytes())
         .with_context(|| format!("cannot write {}", path.display()))
 }

@@ -2,6 +2,7 @@
 //! seen from three camera poses, estimated by the full, fast and baseline algorithms of
 //! `qrm_core::probabilistic`, printed beside the paper's percentiles.
 
+use super::output::stage_json;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use qrm_atomic_file::OutputSet;
@@ -142,18 +143,12 @@ pub fn run(args: &ProbabilisticArgs) -> Result<()> {
         "rows": rows,
         "seconds": started.elapsed().as_secs_f64(),
     });
-    for (name, value) in [
-        ("table1.json", table),
-        ("outcomes.json", serde_json::to_value(&outcomes)?),
-    ] {
-        let path = args.out.join(name);
-        outputs
-            .stage_bytes(
-                &path,
-                (serde_json::to_string_pretty(&value)? + "\n").as_bytes(),
-            )
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
+    stage_json(&mut outputs, &args.out.join("table1.json"), &table)?;
+    stage_json(
+        &mut outputs,
+        &args.out.join("outcomes.json"),
+        &serde_json::to_value(&outcomes)?,
+    )?;
     outputs
         .commit()
         .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;

@@ -294,8 +294,7 @@ impl SceneRanks {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calculus::{Calculus, RelationSet};
-    use crate::map::Observation;
+    use crate::map::testing::converged;
     use proptest::prelude::*;
 
     /// 004 Fig. 20, the rank matrix behind its printed mnv matrix (seed digest B.3).
@@ -326,28 +325,6 @@ mod tests {
         assert_eq!(ranks.most_isolated(None).possible, vec![0]);
     }
 
-    /// The map that knows every triple's true relation.
-    fn converged(points: &[Point]) -> Hypergraph<Edc> {
-        let n = points.len() as u32;
-        let mut observations = Vec::new();
-        for a in 0..n {
-            for b in 0..n {
-                for c in 0..n {
-                    if a == b || b == c || a == c {
-                        continue;
-                    }
-                    let r =
-                        Edc::classify(points[a as usize], points[b as usize], points[c as usize])
-                            .expect("points in general position");
-                    observations.push(Observation::new(a, b, c, RelationSet::single(r)));
-                }
-            }
-        }
-        let mut map = Hypergraph::new();
-        map.fuse(&observations).expect("true relations agree");
-        map
-    }
-
     fn field() -> impl Strategy<Value = Vec<Point>> {
         prop::collection::vec((-50.0..50.0f64, -50.0..50.0f64), 4..9)
             .prop_map(|v| v.into_iter().map(|(x, y)| Point::new(x, y)).collect())
@@ -360,7 +337,7 @@ mod tests {
         /// qualitative most isolated is the metric one (seed digest B.9, test 7).
         #[test]
         fn map_ranks_equal_true_ranks_on_converged_maps(points in field()) {
-            let map = converged(&points);
+            let map = converged::<Edc>(&points);
             let truth = Positions(&points);
             let from_map = MapNearness::new(&map);
             let all: Vec<usize> = (0..points.len()).collect();

@@ -104,9 +104,8 @@ pub fn sampled_legs(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calculus::{Calculus, RelationSet};
     use crate::geometry::Point;
-    use crate::map::Observation;
+    use crate::map::testing::converged;
 
     #[test]
     fn a_converged_map_has_only_proven_legs_and_every_realization_agrees() {
@@ -114,24 +113,7 @@ mod tests {
             .iter()
             .map(|&(x, y)| Point::new(x, y))
             .collect();
-        let mut observations = Vec::new();
-        for a in 0..5u32 {
-            for b in 0..5u32 {
-                for c in 0..5u32 {
-                    if a != b && b != c && a != c {
-                        let r = Edc::classify(
-                            points[a as usize],
-                            points[b as usize],
-                            points[c as usize],
-                        )
-                        .expect("general position");
-                        observations.push(Observation::new(a, b, c, RelationSet::single(r)));
-                    }
-                }
-            }
-        }
-        let mut map = Hypergraph::new();
-        map.fuse(&observations).expect("true relations agree");
+        let map = converged::<Edc>(&points);
         let sampled = sampled_legs(&map, 4, 4, 1);
         assert_eq!(sampled.legs, legs(&Positions(&points), 4));
         assert!(sampled.legs.iter().all(Leg::is_proven));

@@ -23,6 +23,9 @@ mod realization;
 mod transaction;
 mod update;
 
+#[cfg(test)]
+pub(crate) mod testing;
+
 pub use hypergraph::{Hypergraph, Triples};
 pub use json::{MapFormatError, MAX_LANDMARKS};
 pub use network::{Network, NetworkTextError};

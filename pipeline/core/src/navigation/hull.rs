@@ -67,29 +67,8 @@ mod tests {
     use crate::edc::Edc;
     use crate::fdc::Fdc;
     use crate::geometry::Point;
-    use crate::map::Observation;
+    use crate::map::testing::converged;
     use proptest::prelude::*;
-
-    /// The map that knows every triple's true relation.
-    fn converged<C: Calculus>(points: &[Point]) -> Hypergraph<C> {
-        let n = points.len() as u32;
-        let mut observations = Vec::new();
-        for a in 0..n {
-            for b in 0..n {
-                for c in 0..n {
-                    if a != b && b != c && a != c {
-                        let r =
-                            C::classify(points[a as usize], points[b as usize], points[c as usize])
-                                .expect("points in general position");
-                        observations.push(Observation::new(a, b, c, RelationSet::single(r)));
-                    }
-                }
-            }
-        }
-        let mut map = Hypergraph::new();
-        map.fuse(&observations).expect("true relations agree");
-        map
-    }
 
     /// Hull edges by geometry: every other point strictly on one side.
     fn true_hull(points: &[Point]) -> Vec<(LandmarkId, LandmarkId)> {
