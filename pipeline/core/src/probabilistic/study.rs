@@ -141,7 +141,15 @@ pub fn run_study(settings: &StudySettings, progress: &(dyn Fn() + Sync)) -> Vec<
                 &centroids,
             );
             let full = score(
-                || estimate_full(&views, settings.noise, settings.full_particles, &mut rng),
+                || {
+                    estimate_full(
+                        &views,
+                        &prior,
+                        settings.noise,
+                        settings.full_particles,
+                        &mut rng,
+                    )
+                },
                 truth,
                 &centroids,
             );
@@ -149,6 +157,7 @@ pub fn run_study(settings: &StudySettings, progress: &(dyn Fn() + Sync)) -> Vec<
                 || {
                     estimate_fast(
                         &views,
+                        &prior,
                         settings.noise.bearing,
                         settings.fast_particles,
                         &mut rng,

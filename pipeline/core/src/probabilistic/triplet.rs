@@ -46,6 +46,14 @@ pub struct Prior {
 }
 
 impl Prior {
+    fn contains(&self, p: Point) -> bool {
+        let n = self.polygon.len();
+        (0..n).all(|i| {
+            let (a, b) = (self.polygon[i], self.polygon[(i + 1) % n]);
+            (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x) >= 0.0
+        })
+    }
+
     /// The parameter interval `[t0, t1]` (t ≥ 0) of the ray `origin + t·dir` inside the polygon.
     fn clip(&self, origin: Point, dir: Point) -> Option<(f64, f64)> {
         let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
@@ -170,6 +178,7 @@ fn log_gaussian(x: f64, sd: f64) -> f64 {
 /// `C` resected, and the log-likelihood of `C`'s bearings at `bearing_sd`.
 fn particle(
     views: &[View],
+    prior: &Prior,
     noise: Option<Noise>,
     bearing_sd: f64,
     rng: &mut impl Rng,
@@ -192,10 +201,13 @@ fn particle(
             let hits = ray_meets_locus(previous, direction(alpha + psi), gamma);
             *hits.get(rng.random_range(0..hits.len().max(1)))?
         };
+        if !prior.contains(x) {
+            return None;
+        }
         poses.push((x, heading(x, view.bearings[0])));
     }
     let phi_c: Vec<f64> = views.iter().map(|v| v.bearings[2]).collect();
-    let c = resect(&poses, &phi_c)?;
+    let c = resect(&poses, &phi_c).filter(|&c| prior.contains(c))?;
     let log_weight = poses
         .iter()
         .zip(&phi_c)
@@ -223,12 +235,13 @@ fn histogram(samples: &[(Point, f64)]) -> Option<Belief> {
 /// chain or no resection).
 pub fn estimate_full(
     views: &[View],
+    prior: &Prior,
     noise: Noise,
     particles: usize,
     rng: &mut impl Rng,
 ) -> Option<Belief> {
     let samples: Vec<(Point, f64)> = (0..particles)
-        .filter_map(|_| particle(views, Some(noise), noise.bearing, rng))
+        .filter_map(|_| particle(views, prior, Some(noise), noise.bearing, rng))
         .collect();
     histogram(&samples)
 }
@@ -237,12 +250,13 @@ pub fn estimate_full(
 /// particles weighted by `C`'s bearings at `bearing_sd`.
 pub fn estimate_fast(
     views: &[View],
+    prior: &Prior,
     bearing_sd: f64,
     particles: usize,
     rng: &mut impl Rng,
 ) -> Option<Belief> {
     let samples: Vec<(Point, f64)> = (0..particles)
-        .filter_map(|_| particle(views, None, bearing_sd, rng))
+        .filter_map(|_| particle(views, prior, None, bearing_sd, rng))
         .collect();
     histogram(&samples)
 }
@@ -334,10 +348,19 @@ mod tests {
             (Point::new(-0.5, 3.5), -1.0),
         ];
         let v = views(c, &poses);
-        let fast = estimate_fast(&v, 0.5f64.to_radians(), 500, &mut rng).unwrap();
+        let prior = Prior {
+            polygon: vec![
+                Point::new(-6.0, -6.0),
+                Point::new(6.0, -6.0),
+                Point::new(6.0, 6.0),
+                Point::new(-6.0, 6.0),
+            ],
+        };
+        let fast = estimate_fast(&v, &prior, 0.5f64.to_radians(), 500, &mut rng).unwrap();
         assert_eq!(fast.most_likely(), truth);
         let full = estimate_full(
             &v,
+            &prior,
             Noise {
                 bearing: 0.5f64.to_radians(),
                 motion: 1f64.to_radians(),
@@ -347,14 +370,6 @@ mod tests {
         )
         .unwrap();
         assert_eq!(full.most_likely(), truth);
-        let prior = Prior {
-            polygon: vec![
-                Point::new(-6.0, -6.0),
-                Point::new(6.0, -6.0),
-                Point::new(6.0, 6.0),
-                Point::new(-6.0, 6.0),
-            ],
-        };
         let baseline = estimate_baseline(&v, &prior, 2000, &mut rng).unwrap();
         assert!(baseline.probability(truth) > 0.0);
     }
