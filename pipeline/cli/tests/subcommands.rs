@@ -396,3 +396,40 @@ fn realizes_a_map() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("not-a-map.json"));
     assert!(!dir.join("bad.json").exists() && !dir.join("bad.png").exists());
 }
+
+/// `simulate probabilistic` writes 002's Table I for the three algorithms, and with almost no
+/// noise the full and fast estimates put everything on the true state.
+#[test]
+fn probabilistic_table_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p");
+    let o = pipeline(&[
+        "simulate",
+        "probabilistic",
+        "--scenarios",
+        "6",
+        "--bearing-noise",
+        "0.01",
+        "--motion-noise",
+        "0.01",
+        "--full-particles",
+        "300",
+        "--fast-particles",
+        "100",
+        "--baseline-samples",
+        "200",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("table1.json")).unwrap()).unwrap();
+    let rows = table["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3);
+    for row in &rows[1..] {
+        assert_eq!(row["dmse"][1].as_f64().unwrap(), 0.0, "{row}");
+    }
+    let outcomes: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("outcomes.json")).unwrap()).unwrap();
+    assert_eq!(outcomes.as_array().unwrap().len(), 6);
+}
