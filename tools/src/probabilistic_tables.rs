@@ -101,14 +101,7 @@ pub fn region_centroids() -> RegionCentroids {
                 let Some(r) = edc::classify(a, b, c) else {
                     continue;
                 };
-                let v = b - a;
-                let length = v.x.hypot(v.y);
-                let (vx, vy) = (v.x / length, v.y / length);
-                let w = c - a;
-                let local = Point::new(
-                    (vy * w.x - vx * w.y) / length,
-                    (vx * w.x + vy * w.y) / length,
-                );
+                let local = c.in_frame(a, b);
                 let s = &mut sums[r as usize - 1];
                 s.0 += local.x;
                 s.1 += local.y;

@@ -9,13 +9,16 @@ use super::font::FAMILY;
 use super::legend::{self, Entry, Key};
 use super::output::{write_figure, Figure};
 use super::palette::curve_colour;
+use plotters::coord::cartesian::Cartesian2d;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::{
-    ChartBuilder, Circle, DrawingArea, DrawingAreaErrorKind, DrawingBackend, LineSeries,
-    PathElement, Text,
+    ChartBuilder, ChartContext, Circle, DrawingArea, DrawingAreaErrorKind, DrawingBackend,
+    LineSeries, PathElement, Text,
 };
 use plotters::style::{Color, IntoFont, RGBColor, WHITE};
+use std::ops::Range;
 use std::path::Path;
 
 /// Measured selection rates, and the model they are compared with.
@@ -164,21 +167,15 @@ impl ReliabilityPicture {
         let (low, high) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
             (l.min(x), h.max(x))
         });
-        let mut chart = ChartBuilder::on(area)
-            .caption("(a) correct selection of the most isolated", (FAMILY, 24))
-            .margin(14)
-            .x_label_area_size(56)
-            .y_label_area_size(76)
-            .build_cartesian_2d((low - 0.3)..(high + 0.3), 0.0..1.02)?;
-        chart
-            .configure_mesh()
-            .x_desc("objects in the scene n (counting the landmark you are at)")
-            .y_desc("R: intended landmark selected")
-            .label_style((FAMILY, 18).into_font())
-            .axis_desc_style((FAMILY, 20).into_font())
-            .light_line_style(RGBColor(243, 243, 243))
-            .bold_line_style(RGBColor(205, 205, 205))
-            .draw()?;
+        let mut chart = rate_chart(
+            area,
+            "(a) correct selection of the most isolated",
+            (low - 0.3)..(high + 0.3),
+            (
+                "objects in the scene n (counting the landmark you are at)",
+                "R: intended landmark selected",
+            ),
+        )?;
         let count = self.selection.len();
         for (i, s) in self.selection.iter().enumerate() {
             let colour = curve_colour(i, count);
@@ -199,21 +196,15 @@ impl ReliabilityPicture {
         &self,
         area: &DrawingArea<DB, Shift>,
     ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-        let mut chart = ChartBuilder::on(area)
-            .caption(&self.calibration_title, (FAMILY, 24))
-            .margin(14)
-            .x_label_area_size(56)
-            .y_label_area_size(76)
-            .build_cartesian_2d(0.0..1.0, 0.0..1.02)?;
-        chart
-            .configure_mesh()
-            .x_desc("predicted reliability e^−U")
-            .y_desc("measured: intended landmark(s) reached")
-            .label_style((FAMILY, 18).into_font())
-            .axis_desc_style((FAMILY, 20).into_font())
-            .light_line_style(RGBColor(243, 243, 243))
-            .bold_line_style(RGBColor(205, 205, 205))
-            .draw()?;
+        let mut chart = rate_chart(
+            area,
+            &self.calibration_title,
+            0.0..1.0,
+            (
+                "predicted reliability e^−U",
+                "measured: intended landmark(s) reached",
+            ),
+        )?;
         chart.draw_series(std::iter::once(DashedPathElement::new(
             vec![(0.0, 0.0), (1.0, 1.0)],
             8,
@@ -244,6 +235,34 @@ impl ReliabilityPicture {
         Ok(())
     }
 }
+
+/// A panel whose y axis is a rate in `[0, 1]`, with its caption, x range and axis texts
+/// `(x, y)`, mesh drawn: both panels of the figure.
+fn rate_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    x_range: Range<f64>,
+    (x_desc, y_desc): (&str, &str),
+) -> Result<RateChart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, (FAMILY, 24))
+        .margin(14)
+        .x_label_area_size(56)
+        .y_label_area_size(76)
+        .build_cartesian_2d(x_range, 0.0..1.02)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style((FAMILY, 18).into_font())
+        .axis_desc_style((FAMILY, 20).into_font())
+        .light_line_style(RGBColor(243, 243, 243))
+        .bold_line_style(RGBColor(205, 205, 205))
+        .draw()?;
+    Ok(chart)
+}
+
+type RateChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 #[cfg(test)]
 mod tests {

@@ -118,7 +118,7 @@ pub struct Terrain<'a> {
 
 impl Terrain<'_> {
     /// The stereo pair at `pose`.
-    pub(crate) fn panoramas(&self, pose: Pose) -> (RgbImage, RgbImage) {
+    fn panoramas(&self, pose: Pose) -> (RgbImage, RgbImage) {
         let image = |eye| {
             let r = render(self.world, self.calib, pose, eye);
             RgbImage::from_raw(r.width, r.height, r.rgb).expect("a render fills its image")

@@ -25,7 +25,7 @@
 //! reliability assumes (`navigate drive` measures driving).
 
 use crate::closed_loop::{Terrain, CLEARANCE_M};
-use crate::render::{render, Eye, Pose};
+use crate::render::{render, Eye, Pose, Render};
 use image::RgbImage;
 use qrm_core::directions::reliability::most_isolated_seen;
 use qrm_core::directions::{Leg, LegGraph};
@@ -206,10 +206,13 @@ fn select_from_panorama(
             range_log_errors: Vec::new(),
         };
     };
-    let left = render(world, terrain.calib, pose, Eye::Left);
-    let rock_ids = left.rock_id.clone();
-    let width = left.width;
-    let left = RgbImage::from_raw(left.width, left.height, left.rgb).expect("a render fills it");
+    let Render {
+        width,
+        height,
+        rgb,
+        rock_id: rock_ids,
+    } = render(world, terrain.calib, pose, Eye::Left);
+    let left = RgbImage::from_raw(width, height, rgb).expect("a render fills it");
     let right = {
         let r = render(world, terrain.calib, pose, Eye::Right);
         RgbImage::from_raw(r.width, r.height, r.rgb).expect("a render fills it")

@@ -5,7 +5,7 @@
 
 use super::map::{calculus_of, load, read};
 use super::output::stage_json;
-use super::pictures::crop_with_context;
+use super::pictures::{crop_with_context, plot_image};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use image::{ImageEncoder, RgbImage};
@@ -694,11 +694,7 @@ fn stage_leg_pictures(
     let tiles: Vec<Tile> = tiles
         .iter()
         .map(|(image, caption, note)| Tile {
-            image: qrm_plot::RgbImage {
-                pixels: image.as_raw(),
-                width: image.width(),
-                height: image.height(),
-            },
+            image: plot_image(image),
             caption: caption.clone(),
             note: note.clone(),
         })

@@ -332,7 +332,7 @@ pub(super) fn crop_with_context(image: &RgbImage, bbox: [u32; 4]) -> (RgbImage, 
     (piece, tile)
 }
 
-fn plot_image(image: &RgbImage) -> qrm_plot::RgbImage<'_> {
+pub(super) fn plot_image(image: &RgbImage) -> qrm_plot::RgbImage<'_> {
     qrm_plot::RgbImage {
         pixels: image.as_raw(),
         width: image.width(),

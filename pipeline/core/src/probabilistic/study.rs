@@ -5,14 +5,16 @@
 use super::belief::Belief;
 use super::metrics::{dmse, entropy, gmd};
 use super::tensor::RegionCentroids;
-use super::triplet::{estimate_baseline, estimate_fast, estimate_full, Noise, Prior, View};
+use super::triplet::{
+    angle_to, estimate_baseline, estimate_fast, estimate_full, wrap, Noise, Prior, View,
+};
 use crate::edc;
 use crate::geometry::Point;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 use std::time::Instant;
 
 /// 002 §IV's world: `x ∈ [−3, 3]`, `y ∈ [−3, 4]`.
@@ -57,14 +59,6 @@ pub struct Outcome {
     pub fast: Score,
 }
 
-fn wrap(angle: f64) -> f64 {
-    (angle + PI).rem_euclid(TAU) - PI
-}
-
-fn angle_to(from: Point, to: Point) -> f64 {
-    (to.y - from.y).atan2(to.x - from.x)
-}
-
 /// A random triplet and camera poses in the box, the views with noise, the truth `AB:C`, and
 /// the box in the AB frame (the baseline's prior).
 pub fn scenario(settings: &StudySettings, rng: &mut impl Rng) -> (Vec<View>, u8, Prior) {
@@ -94,19 +88,7 @@ pub fn scenario(settings: &StudySettings, rng: &mut impl Rng) -> (Vec<View>, u8,
             })
             .collect();
         // The box in the frame A = (0,0), B = (0,1).
-        let v = b - a;
-        let length = v.x.hypot(v.y);
-        let (vx, vy) = (v.x / length, v.y / length);
-        let polygon = BOX
-            .iter()
-            .map(|&p| {
-                let w = p - a;
-                Point::new(
-                    (vy * w.x - vx * w.y) / length,
-                    (vx * w.x + vy * w.y) / length,
-                )
-            })
-            .collect();
+        let polygon = BOX.iter().map(|p| p.in_frame(a, b)).collect();
         return (views, truth, Prior { polygon });
     }
 }

@@ -80,7 +80,8 @@ impl Prior {
 const A: Point = Point::new(0.0, 0.0);
 const B: Point = Point::new(0.0, 1.0);
 
-fn wrap(angle: f64) -> f64 {
+/// `angle` in `[−π, π)`.
+pub(super) fn wrap(angle: f64) -> f64 {
     (angle + PI).rem_euclid(TAU) - PI
 }
 
@@ -88,7 +89,8 @@ fn direction(angle: f64) -> Point {
     Point::new(angle.cos(), angle.sin())
 }
 
-fn angle_to(from: Point, to: Point) -> f64 {
+/// The world angle of the direction from `from` to `to`.
+pub(super) fn angle_to(from: Point, to: Point) -> f64 {
     (to.y - from.y).atan2(to.x - from.x)
 }
 
