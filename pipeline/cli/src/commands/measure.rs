@@ -52,39 +52,64 @@ pub fn parse_order(text: &str) -> Result<Vec<(usize, usize)>> {
 }
 
 pub fn run(args: MeasureArgs) -> Result<()> {
-    let pairs = parse_order(&args.order)?;
-    let order = RangeOrder::from_pairs(3, &pairs).context("range order")?;
-    if !(0.0..MAX_BEARING_UNCERTAINTY.to_degrees()).contains(&args.uncertainty) {
-        bail!(
-            "--uncertainty {} must lie in [0, {}) degrees",
-            args.uncertainty,
-            MAX_BEARING_UNCERTAINTY.to_degrees()
-        );
-    }
-    let bearings = [args.a, args.b, args.c]
-        .iter()
-        .map(|deg| Bearing {
-            angle: deg.to_radians(),
-            uncertainty: args.uncertainty.to_radians(),
-        })
-        .collect();
-    let panorama = StationView::new(bearings, order)?;
-    match args.calculus {
-        CalculusName::Edc => print::<Edc>(&panorama),
-        CalculusName::Fdc => print::<Fdc>(&panorama),
+    let relations = relations(
+        args.calculus,
+        [args.a, args.b, args.c],
+        &args.order,
+        args.uncertainty,
+    )?;
+    for (name, set) in RELATION_NAMES.iter().zip(relations) {
+        println!("{name} = {set}");
     }
     Ok(())
 }
 
-fn print<C: Calculus>(panorama: &StationView) {
+/// The relations [`relations`] returns, in order.
+pub const RELATION_NAMES: [&str; 6] = ["AB:C", "BC:A", "CA:B", "BA:C", "CB:A", "AC:B"];
+
+/// The relations of landmarks A, B, C seen at bearings `degrees` (counter-clockwise, any
+/// zero, each within ±`uncertainty` degrees) with the range `order` (`A<B<C`, `A<B,A<C`, or
+/// empty), in the order of [`RELATION_NAMES`] (000 §IV).
+pub fn relations(
+    calculus: CalculusName,
+    degrees: [f64; 3],
+    order: &str,
+    uncertainty: f64,
+) -> Result<[RelationSet; 6]> {
+    let pairs = parse_order(order)?;
+    let order = RangeOrder::from_pairs(3, &pairs).context("range order")?;
+    if !(0.0..MAX_BEARING_UNCERTAINTY.to_degrees()).contains(&uncertainty) {
+        bail!(
+            "--uncertainty {} must lie in [0, {}) degrees",
+            uncertainty,
+            MAX_BEARING_UNCERTAINTY.to_degrees()
+        );
+    }
+    let bearings = degrees
+        .iter()
+        .map(|deg| Bearing {
+            angle: deg.to_radians(),
+            uncertainty: uncertainty.to_radians(),
+        })
+        .collect();
+    let panorama = StationView::new(bearings, order)?;
+    Ok(match calculus {
+        CalculusName::Edc => measured::<Edc>(&panorama),
+        CalculusName::Fdc => measured::<Fdc>(&panorama),
+    })
+}
+
+fn measured<C: Calculus>(panorama: &StationView) -> [RelationSet; 6] {
     let [ab_c, bc_a, ca_b] = panorama.measure_triple::<C>([0, 1, 2], [C::universe(); 3]);
     let inverse = |s: RelationSet| C::tables().inverse(s);
-    println!("AB:C = {ab_c}");
-    println!("BC:A = {bc_a}");
-    println!("CA:B = {ca_b}");
-    println!("BA:C = {}", inverse(ab_c));
-    println!("CB:A = {}", inverse(bc_a));
-    println!("AC:B = {}", inverse(ca_b));
+    [
+        ab_c,
+        bc_a,
+        ca_b,
+        inverse(ab_c),
+        inverse(bc_a),
+        inverse(ca_b),
+    ]
 }
 
 #[cfg(test)]

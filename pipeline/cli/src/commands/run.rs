@@ -1,5 +1,6 @@
 //! `pipeline run --images DIR`: panoramas in, qualitative map and RNG out (docs/RUN.md).
 
+use qrm_synth::evaluation::Evaluation;
 use super::pictures::{stage_pictures, PanoramaSize, RunImages};
 use super::rng_json;
 use super::rng_picture::{stage_rng_png, EdgeCut, DEFAULT_MAX_COST};
@@ -114,19 +115,28 @@ fn rng_drawing(map: &Hypergraph<Edc>, rng: &RngEstimate) -> RngDrawing {
     }
 }
 
-/// Progress bars on the terminal, one per stage; warnings printed above them and kept for
-/// the tally at the end. Quiet: neither bars nor warning lines.
+/// A caller's progress function (the Python package's): `(stage, done, total)` with stage
+/// `detect` or `map`, called as each stage begins and after every station.
+pub type Listener = dyn Fn(&str, usize, usize) + Send + Sync;
+
+/// Progress bars on the terminal, one per stage, or a caller's [`Listener`] instead; warnings
+/// printed above the bars and kept for the tally at the end. Quiet: neither bars nor warning
+/// lines.
 #[derive(Default)]
 struct Bars {
     current: Mutex<Option<ProgressBar>>,
     warnings: Mutex<Vec<String>>,
     quiet: bool,
+    listener: Option<Box<Listener>>,
+    /// The listener's stage and count: (stage, done, total).
+    position: Mutex<(&'static str, usize, usize)>,
 }
 
 impl Bars {
-    fn quiet() -> Bars {
+    fn new(quiet: bool, listener: Option<Box<Listener>>) -> Bars {
         Bars {
-            quiet: true,
+            quiet: quiet || listener.is_some(),
+            listener,
             ..Bars::default()
         }
     }
@@ -162,13 +172,17 @@ impl Bars {
 
 impl Progress for Bars {
     fn begin(&self, stage: Stage, stations: usize) {
-        if self.quiet {
-            return;
-        }
         let what = match stage {
             Stage::Detect => "detect",
             Stage::Map => "map",
         };
+        if let Some(listener) = &self.listener {
+            *self.position.lock().expect("no panics hold it") = (what, 0, stations);
+            listener(what, 0, stations);
+        }
+        if self.quiet {
+            return;
+        }
         let bar = ProgressBar::new(stations as u64);
         bar.set_style(
             ProgressStyle::with_template(&format!(
@@ -181,6 +195,14 @@ impl Progress for Bars {
     }
 
     fn advance(&self) {
+        if let Some(listener) = &self.listener {
+            let (stage, done, total) = {
+                let mut position = self.position.lock().expect("no panics hold it");
+                position.1 += 1;
+                *position
+            };
+            listener(stage, done, total);
+        }
         self.with_bar(|bar| bar.inc(1));
     }
 
@@ -206,7 +228,34 @@ impl Progress for Bars {
     }
 }
 
+/// A finished run: its summary (summary.json), the scoring against truth if there was one,
+/// and the warnings by kind.
+pub struct Completed {
+    pub summary: RunSummary,
+    pub evaluation: Option<Evaluation>,
+    /// Warnings by kind, most frequent first: (count, first message).
+    pub warnings: Vec<(usize, String)>,
+    /// Wall seconds of the whole run, and of the scoring after the outputs.
+    pub total_seconds: f64,
+    pub scoring_seconds: Option<f64>,
+}
+
+/// `pipeline run`: maps, writes the outputs and prints the summary.
 pub fn run(args: RunArgs) -> Result<()> {
+    let completed = execute(&args, None)?;
+    // Printed once every file is written: a reader that stops early ends the process.
+    print_summary(&completed, &args.out);
+    print_warnings(&completed.warnings, args.quiet);
+    if let Some(evaluation) = &completed.evaluation {
+        super::eval::print_report(evaluation);
+    }
+    Ok(())
+}
+
+/// Maps the panoramas of `args.images` and writes every output into `args.out`, reporting
+/// progress on terminal bars, or to `listener` instead (then no bars and no warning lines).
+/// Prints nothing.
+pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Completed> {
     let started = Instant::now();
     let survey = Survey::open(&args.images)?;
     // The run's pictures (rng.png) would be read as panoramas by the next run.
@@ -216,7 +265,7 @@ pub fn run(args: RunArgs) -> Result<()> {
             args.out.display()
         );
     }
-    let calib = load_calibration(&args)?;
+    let calib = load_calibration(args)?;
     // The truth, given or found in the image directory, is read before any work: a bad one
     // would otherwise fail only once the run's outputs had replaced the earlier ones. A given
     // one must also describe every image (a found one is checked image by image when scoring,
@@ -241,11 +290,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         }
     }
     let checks_seconds = started.elapsed().as_secs_f64();
-    let bars = if args.quiet {
-        Bars::quiet()
-    } else {
-        Bars::default()
-    };
+    let bars = Bars::new(args.quiet, listener);
     for path in &survey.unpaired {
         bars.warn(&format!(
             "{} has no _left partner and is not used",
@@ -286,7 +331,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     };
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
-    let mut recorders = recorders(&args)?;
+    let mut recorders = recorders(args)?;
     let mapper: Mapper<Edc> = Mapper::new(calib, settings.sensor, settings.association);
     let traverse = map_stations(&detected, mapper, &bars, |record, mapper| {
         record_station(&mut recorders, record, mapper, &survey, &calib)
@@ -340,13 +385,13 @@ pub fn run(args: RunArgs) -> Result<()> {
         None => None,
     };
     let scoring_seconds = evaluation.as_ref().map(|_| scoring.elapsed().as_secs_f64());
-    // Printed once every file is written: a reader that stops early ends the process.
-    print_summary(&summary, &args.out, started, scoring_seconds);
-    print_warnings(&bars.tally(), args.quiet);
-    if let Some(evaluation) = &evaluation {
-        super::eval::print_report(evaluation);
-    }
-    Ok(())
+    Ok(Completed {
+        summary,
+        evaluation,
+        warnings: bars.tally(),
+        total_seconds: started.elapsed().as_secs_f64(),
+        scoring_seconds,
+    })
 }
 
 /// Whether `a` and `b` name the same existing directory.
@@ -400,14 +445,14 @@ fn record_station(
     Ok(())
 }
 
-fn print_summary(summary: &RunSummary, out: &Path, started: Instant, scoring: Option<f64>) {
-    println!("{summary}");
-    let scoring = scoring.map_or(String::new(), |s| {
+fn print_summary(completed: &Completed, out: &Path) {
+    println!("{}", completed.summary);
+    let scoring = completed.scoring_seconds.map_or(String::new(), |s| {
         format!(" (scoring against truth, after the outputs: {s:.2} s)")
     });
     println!(
         "total {:.2} s{scoring}; outputs in {}",
-        started.elapsed().as_secs_f64(),
+        completed.total_seconds,
         out.display()
     );
     let pictures: Vec<String> = [

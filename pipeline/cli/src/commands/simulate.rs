@@ -65,26 +65,33 @@ pub struct SensorArgs {
 
 impl SensorArgs {
     fn sensor(&self, nearest: Option<usize>) -> Result<Sensor> {
-        if nearest.is_some_and(|n| n < 3) {
-            bail!("--nearest must be at least 3 (a triple)");
-        }
-        if !(0.0..MAX_BEARING_UNCERTAINTY.to_degrees()).contains(&self.bearing_noise) {
-            bail!(
-                "--bearing-noise {} must lie in [0, {}) degrees",
-                self.bearing_noise,
-                MAX_BEARING_UNCERTAINTY.to_degrees()
-            );
-        }
-        if !(0.0..=1.0).contains(&self.order_swaps) {
-            bail!("--order-swaps {} must be a probability", self.order_swaps);
-        }
-        Ok(Sensor {
-            nearest,
-            bearing_noise: self.bearing_noise.to_radians(),
-            bearing_uncertainty: self.bearing_noise.to_radians(),
-            order_swap_probability: self.order_swaps,
-        })
+        sensor(self.bearing_noise, self.order_swaps, nearest)
     }
+}
+
+/// The simulated sensor: bearing errors uniform within ±`bearing_noise` degrees (and the
+/// measurement told so), each adjacent pair of the range order swapped with probability
+/// `order_swaps`, the `nearest` landmarks seen (all: `None`).
+pub fn sensor(bearing_noise: f64, order_swaps: f64, nearest: Option<usize>) -> Result<Sensor> {
+    if nearest.is_some_and(|n| n < 3) {
+        bail!("--nearest must be at least 3 (a triple)");
+    }
+    if !(0.0..MAX_BEARING_UNCERTAINTY.to_degrees()).contains(&bearing_noise) {
+        bail!(
+            "--bearing-noise {} must lie in [0, {}) degrees",
+            bearing_noise,
+            MAX_BEARING_UNCERTAINTY.to_degrees()
+        );
+    }
+    if !(0.0..=1.0).contains(&order_swaps) {
+        bail!("--order-swaps {} must be a probability", order_swaps);
+    }
+    Ok(Sensor {
+        nearest,
+        bearing_noise: bearing_noise.to_radians(),
+        bearing_uncertainty: bearing_noise.to_radians(),
+        order_swap_probability: order_swaps,
+    })
 }
 
 #[derive(Args, Debug)]
@@ -155,7 +162,8 @@ pub fn run_command(command: SimulateCommand) -> Result<()> {
     }
 }
 
-fn montecarlo(args: MonteCarloArgs) -> Result<()> {
+/// The study `simulate montecarlo` runs for `args`, and its calculus.
+pub fn study(args: &MonteCarloArgs) -> Result<(MonteCarlo, CalculusName)> {
     let (mut study, default_calculus) = match args.study {
         Study::Fig7 => (MonteCarlo::fig7(), CalculusName::Edc),
         Study::Dissertation => (MonteCarlo::dissertation_random(), CalculusName::Fdc),
@@ -177,9 +185,14 @@ fn montecarlo(args: MonteCarloArgs) -> Result<()> {
     }
     study.sensor = args.sensor.sensor(None)?;
     study.seed = args.seed;
+    Ok((study, args.calculus.unwrap_or(default_calculus)))
+}
+
+fn montecarlo(args: MonteCarloArgs) -> Result<()> {
+    let (study, calculus) = study(&args)?;
     let bar = progress(study.runs() as u64, "mapping runs");
     let start = Instant::now();
-    let result = match args.calculus.unwrap_or(default_calculus) {
+    let result = match calculus {
         CalculusName::Edc => study.run::<Edc>(&|| bar.inc(1)),
         CalculusName::Fdc => study.run::<Fdc>(&|| bar.inc(1)),
     };

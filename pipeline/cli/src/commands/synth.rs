@@ -8,6 +8,7 @@ use qrm_synth::dataset::{write_dataset, Counts, Preset, Request, Variant, Varian
 use qrm_synth::{default_calibration, Capture, Encoding, Scenery};
 use qrm_vision::calib::{Calibration, ColumnDirection};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// The presets as the command line spells them (`sparse-large`).
@@ -103,13 +104,61 @@ pub struct SynthArgs {
     jpeg: Option<u8>,
 }
 
+/// A rendered dataset: what `pipeline synth` prints.
+pub struct Rendered {
+    pub preset: &'static str,
+    pub rocks: usize,
+    pub stations: usize,
+    pub panoramas: usize,
+    pub width: u32,
+    pub height: u32,
+    pub seconds: f64,
+    /// The drawn variant of a stress preset, described.
+    pub variant: Option<String>,
+}
+
+/// `pipeline synth`: renders with a progress bar and prints what was written.
 pub fn run(args: SynthArgs) -> Result<()> {
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} rendering [{bar:40}] {pos}/{len} stations ({elapsed}, eta {eta})",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    let rendered = render(&args, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })?;
+    bar.finish_and_clear();
+    println!(
+        "{} (seed {}): {} rocks, {} stations, {} panoramas of {} × {} in {:.1} s → {}",
+        rendered.preset,
+        args.seed,
+        rendered.rocks,
+        rendered.stations,
+        rendered.panoramas,
+        rendered.width,
+        rendered.height,
+        rendered.seconds,
+        args.out.display()
+    );
+    if let Some(v) = &rendered.variant {
+        println!("{v}");
+    }
+    Ok(())
+}
+
+/// Renders the dataset `args` asks for into `args.out`; `progress(done, total)` after every
+/// station (and once with 0 at the start). Prints nothing.
+pub fn render(args: &SynthArgs, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<Rendered> {
     let base = match &args.calib {
         Some(path) => Calibration::load(path)?,
         None => default_calibration(),
     };
     let preset = Preset::from(args.preset);
-    let variant = variant(&args, preset, &base)?;
+    let variant = variant(args, preset, &base)?;
     let calib = variant.calibration(&base)?;
     if args.rocks == Some(0) || args.stations == Some(0) {
         bail!("--rocks and --stations must be positive");
@@ -133,34 +182,22 @@ pub fn run(args: SynthArgs) -> Result<()> {
         .layout_clustered(args.seed, request.counts, variant.scenery.cluster)
         .stations
         .len();
-    let bar = ProgressBar::new(stations as u64);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} rendering [{bar:40}] {pos}/{len} stations ({elapsed}, eta {eta})",
-        )
-        .expect("static template")
-        .progress_chars("=> "),
-    );
+    progress(0, stations);
+    let done = AtomicUsize::new(0);
+    let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, stations);
     let start = Instant::now();
-    let truth = write_dataset(&args.out, &calib, request, &|| bar.inc(1))
+    let truth = write_dataset(&args.out, &calib, request, &tick)
         .with_context(|| format!("rendering into {}", args.out.display()))?;
-    bar.finish_and_clear();
-    println!(
-        "{} (seed {}): {} rocks, {} stations, {} panoramas of {} × {} in {:.1} s → {}",
-        preset.name(),
-        args.seed,
-        truth.rocks.len(),
-        truth.stations.len(),
-        truth.images.len(),
-        calib.image.width,
-        calib.image.height,
-        start.elapsed().as_secs_f64(),
-        args.out.display()
-    );
-    if let Some(v) = &truth.variant {
-        println!("{}", describe(v, variant.scale));
-    }
-    Ok(())
+    Ok(Rendered {
+        preset: preset.name(),
+        rocks: truth.rocks.len(),
+        stations: truth.stations.len(),
+        panoramas: truth.images.len(),
+        width: calib.image.width,
+        height: calib.image.height,
+        seconds: start.elapsed().as_secs_f64(),
+        variant: truth.variant.as_ref().map(|v| describe(v, variant.scale)),
+    })
 }
 
 /// The look asked for: the preset's own (or, for `stress`, the seed's draw), with each option

@@ -55,6 +55,19 @@ impl MonteCarlo {
         self.maps * self.nearest.len()
     }
 
+    /// Maps random map number `map` of the study with the `nearest` landmarks seen: one run of
+    /// [`MonteCarlo::run`], on its own so that a study can be split across processes or machines
+    /// (the Python package's Dask sweeps) and give the same steps.
+    pub fn run_one<C: Calculus>(&self, nearest: Option<usize>, map: usize) -> Vec<Step> {
+        let seed = self.seed.wrapping_mul(1_000_003).wrapping_add(map as u64);
+        let scenario = Scenario::random(seed, self.landmarks, self.stations, self.side);
+        let sensor = Sensor {
+            nearest,
+            ..self.sensor
+        };
+        run::<C>(&scenario, &sensor, seed ^ 0x5eed).0
+    }
+
     /// Runs every map for every series in parallel.
     pub fn run<C: Calculus>(&self, tick: &(dyn Fn() + Sync)) -> MonteCarloResult {
         let jobs: Vec<(usize, usize)> = (0..self.nearest.len())
@@ -63,13 +76,7 @@ impl MonteCarlo {
         let results: Vec<(usize, Vec<Step>)> = jobs
             .into_par_iter()
             .map(|(s, m)| {
-                let seed = self.seed.wrapping_mul(1_000_003).wrapping_add(m as u64);
-                let scenario = Scenario::random(seed, self.landmarks, self.stations, self.side);
-                let sensor = Sensor {
-                    nearest: self.nearest[s],
-                    ..self.sensor
-                };
-                let (steps, _) = run::<C>(&scenario, &sensor, seed ^ 0x5eed);
+                let steps = self.run_one::<C>(self.nearest[s], m);
                 tick();
                 (s, steps)
             })
