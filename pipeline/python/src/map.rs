@@ -12,7 +12,8 @@ use qrm_core::calculus::{Calculus, RelationSet};
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
 use qrm_core::map::{
-    Contradiction, Hypergraph, LandmarkId, Network, Observation, Sighting, UpdateReport,
+    Contradiction, Hypergraph, LandmarkId, Network, Observation, RealizeSettings, Sighting,
+    UpdateReport,
 };
 use qrm_core::measurement::{Bearing, RangeOrder, StationView};
 use qrm_core::neighborhood::estimate;
@@ -316,6 +317,33 @@ impl Map {
                 "FDC maps have no RNG estimate (no lune)",
             )),
         }
+    }
+
+    /// Positions under which every relation holds, found by search as `pipeline map realize`
+    /// (a witness layout for drawing), with its defaults for settings not given: (landmarks,
+    /// x, y, violated, constrained).
+    #[pyo3(signature = (seed = None, sweeps = None, restarts = None))]
+    fn realize(
+        &self,
+        py: Python<'_>,
+        seed: Option<u64>,
+        sweeps: Option<usize>,
+        restarts: Option<usize>,
+    ) -> (Vec<LandmarkId>, Vec<f64>, Vec<f64>, usize, usize) {
+        let default = RealizeSettings::default();
+        let settings = RealizeSettings {
+            seed: seed.unwrap_or(default.seed),
+            sweeps: sweeps.unwrap_or(default.sweeps),
+            restarts: restarts.unwrap_or(default.restarts),
+        };
+        let found = py.detach(|| with_map!(&self.inner, m => m.realize(&settings)));
+        (
+            found.landmarks,
+            found.positions.iter().map(|p| p.x).collect(),
+            found.positions.iter().map(|p| p.y).collect(),
+            found.violated,
+            found.constrained,
+        )
     }
 
     fn copy(&self) -> Map {

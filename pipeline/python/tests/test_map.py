@@ -137,3 +137,15 @@ def test_bad_input_raises(call, error):
     with pytest.raises(error) as raised:
         call(qrm.Map())
     assert str(raised.value)
+
+
+def test_realize_matches_cli(simulated, cli, tmp_path):
+    m = qrm.Map.load(simulated / "a" / "map.json")
+    mine = m.realize(seed=2)
+    cli("map", "realize", simulated / "a" / "map.json", "--seed", 2, "--out", tmp_path / "r.json",
+        check=False)
+    theirs = json.loads((tmp_path / "r.json").read_text())
+    assert mine["exact"] == theirs["exact"] and mine["violated"] == theirs["violated"]
+    assert list(mine["landmarks"]) == [p["landmark"] for p in theirs["landmarks"]]
+    assert np.allclose(mine["x"], [p["x"] for p in theirs["landmarks"]])
+    assert np.allclose(mine["y"], [p["y"] for p in theirs["landmarks"]])

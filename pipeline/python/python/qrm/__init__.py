@@ -265,6 +265,23 @@ class Map:
         certain), pruned pairs, total cost. EDC maps only."""
         return json.loads(self._inner.rng_json())
 
+    def realize(
+        self, seed: Optional[int] = None, sweeps: Optional[int] = None, restarts: Optional[int] = None
+    ) -> dict:
+        """Positions under which every relation of the map holds, found by search as
+        ``pipeline map realize`` does, with its defaults (a witness layout for drawing; the map
+        fixes no metric positions): ``{"landmarks", "x", "y"}`` as numpy arrays, ``exact`` (every constrained
+        relation holds), ``violated`` and ``constrained`` counts."""
+        ids, x, y, violated, constrained = self._inner.realize(seed, sweeps, restarts)
+        return {
+            "landmarks": np.asarray(ids, dtype=np.uint32),
+            "x": np.asarray(x),
+            "y": np.asarray(y),
+            "exact": violated == 0,
+            "violated": violated,
+            "constrained": constrained,
+        }
+
     def copy(self) -> "Map":
         return Map._wrap(self._inner.copy())
 
