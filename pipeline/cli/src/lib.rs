@@ -219,7 +219,12 @@ pub fn dispatch(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Demo => demo(),
         Command::Classify { calculus, a, b, c } => {
-            match classify(calculus, parse_point(&a)?, parse_point(&b)?, parse_point(&c)?)? {
+            match classify(
+                calculus,
+                parse_point(&a)?,
+                parse_point(&b)?,
+                parse_point(&c)?,
+            )? {
                 Some(r) => println!("{r}"),
                 None => println!("boundary"),
             }

@@ -33,12 +33,7 @@ pub fn members(set: RelationSet) -> Vec<u8> {
 
 /// The relation number of C to the directed pair A→B; `None` on a boundary.
 #[pyfunction]
-fn classify(
-    calculus: &str,
-    a: (f64, f64),
-    b: (f64, f64),
-    c: (f64, f64),
-) -> PyResult<Option<u8>> {
+fn classify(calculus: &str, a: (f64, f64), b: (f64, f64), c: (f64, f64)) -> PyResult<Option<u8>> {
     let point = |(x, y): (f64, f64)| -> PyResult<Point> {
         if !x.is_finite() || !y.is_finite() {
             return Err(PyValueError::new_err(format!(
@@ -81,7 +76,7 @@ fn measure(
     order: &str,
     uncertainty: f64,
 ) -> PyResult<Vec<Vec<u8>>> {
-    let sets = relations(calculus_named(calculus)?, bearings, order, uncertainty)
-        .map_err(errors::qrm)?;
+    let sets =
+        relations(calculus_named(calculus)?, bearings, order, uncertainty).map_err(errors::qrm)?;
     Ok(sets.into_iter().map(members).collect())
 }

@@ -88,10 +88,11 @@ fn run(py: Python<'_>, args: Vec<String>, progress: Option<Py<PyAny>>) -> PyResu
     let callback = Callback::new(progress);
     let listener: Option<Box<Listener>> = callback.function.is_some().then(|| {
         let callback = Arc::clone(&callback);
-        Box::new(move |stage: &str, done, total| callback.call(stage, done, total))
-            as Box<Listener>
+        Box::new(move |stage: &str, done, total| callback.call(stage, done, total)) as Box<Listener>
     });
-    let completed = py.detach(|| execute(&args, listener)).map_err(errors::qrm)?;
+    let completed = py
+        .detach(|| execute(&args, listener))
+        .map_err(errors::qrm)?;
     let mut summary = serde_json::to_value(&completed.summary)
         .map_err(|e| errors::QrmError::new_err(e.to_string()))?;
     summary["warnings"] = serde_json::json!(completed.warnings);

@@ -21,7 +21,10 @@ create_exception!(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("QrmError", m.py().get_type::<QrmError>())?;
-    m.add("ContradictionError", m.py().get_type::<ContradictionError>())?;
+    m.add(
+        "ContradictionError",
+        m.py().get_type::<ContradictionError>(),
+    )?;
     Ok(())
 }
 

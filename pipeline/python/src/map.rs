@@ -114,11 +114,7 @@ fn conflict_lines<C: Calculus>(network: &Network<C>) -> String {
         .collect()
 }
 
-fn close_network<C: Calculus>(
-    py: Python<'_>,
-    text: &str,
-    json: bool,
-) -> PyResult<Hypergraph<C>> {
+fn close_network<C: Calculus>(py: Python<'_>, text: &str, json: bool) -> PyResult<Hypergraph<C>> {
     let network = network::<C>(text, json).map_err(errors::qrm)?;
     py.detach(|| match network.close() {
         Ok(map) => Ok(map),
@@ -179,12 +175,12 @@ impl Map {
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Map> {
         let inner = match calculus_of_json(text)? {
-            CalculusName::Edc => Inner::Edc(
-                Hypergraph::from_json(text).map_err(|e| errors::qrm(e.into()))?,
-            ),
-            CalculusName::Fdc => Inner::Fdc(
-                Hypergraph::from_json(text).map_err(|e| errors::qrm(e.into()))?,
-            ),
+            CalculusName::Edc => {
+                Inner::Edc(Hypergraph::from_json(text).map_err(|e| errors::qrm(e.into()))?)
+            }
+            CalculusName::Fdc => {
+                Inner::Fdc(Hypergraph::from_json(text).map_err(|e| errors::qrm(e.into()))?)
+            }
         };
         Ok(Map { inner })
     }
@@ -286,8 +282,8 @@ impl Map {
                 uncertainty: uncertainty.to_radians(),
             })
             .collect();
-        let view = StationView::new(bearings, order)
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let view =
+            StationView::new(bearings, order).map_err(|e| PyValueError::new_err(e.to_string()))?;
         let r = with_map!(&mut self.inner, m => fuse_view_into(m, py, &view, &landmarks)?);
         report(py, &r)
     }

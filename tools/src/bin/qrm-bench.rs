@@ -5,7 +5,8 @@
 //! - with `--closure`: path-consistency closure of complete random maps (000 §VI-B);
 //! - with `--rng`: the RNG estimate (000 Algorithm 2) of maps of N landmarks, as a run makes
 //!   after every station;
-//! - with `--render`: synthetic panoramas (issue 4), one stereo pair and a 50-station set.
+//! - with `--render`: synthetic panoramas (issue 4), one stereo pair and a 50-station set;
+//! - with `--triple-calls K`: one triple measured K times, the work of a Python `qrm.measure`.
 
 use clap::Parser;
 use qrm_core::calculus::{Calculus, RelationSet};
@@ -39,7 +40,12 @@ struct Args {
     /// every triple, every region open, total range order.
     #[arg(long, num_args = 1.., value_name = "N")]
     measure: Vec<usize>,
-    /// Bearing uncertainty (± degrees) for `--measure`.
+    /// Time this many measurements of one triple (bearings 0°, 40°, 100°, order A<B<C, EDC),
+    /// one after the other on one thread, each from the bearings to the six relations: the
+    /// work of one Python `qrm.measure` call (docs/PYTHON.md compares the two).
+    #[arg(long, value_name = "K")]
+    triple_calls: Option<u32>,
+    /// Bearing uncertainty (± degrees) for `--measure` and `--triple-calls`.
     #[arg(long, default_value_t = 0.0)]
     uncertainty: f64,
     /// Fuse each closure network this many times into a fresh map; prints min and median.
@@ -260,6 +266,33 @@ fn bench_measure(n: usize, uncertainty_deg: f64) {
     );
 }
 
+/// Times `calls` measurements of the triple (0°, 40°, 100°), order A<B<C, ±`uncertainty_deg`.
+fn bench_triple_calls(calls: u32, uncertainty_deg: f64) {
+    let delta = uncertainty_deg.to_radians();
+    let order = RangeOrder::total(&[0, 1, 2]).expect("a chain is acyclic");
+    let start = Instant::now();
+    let mut open = 0usize;
+    for _ in 0..calls {
+        let bearings = [0.0f64, 40.0, 100.0]
+            .iter()
+            .map(|d| Bearing {
+                angle: d.to_radians(),
+                uncertainty: delta,
+            })
+            .collect();
+        let view = StationView::new(bearings, order.clone()).expect("valid panorama");
+        let sets = view.measure_triple::<Edc>([0, 1, 2], [Edc::universe(); 3]);
+        let inverses = sets.map(|s| Edc::tables().inverse(s));
+        open += sets.iter().chain(&inverses).map(|s| s.len()).sum::<usize>();
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    println!(
+        "triple ±{uncertainty_deg}°: {calls} measurements, {:.2} µs each ({:.2} open regions per relation)",
+        seconds / f64::from(calls) * 1e6,
+        open as f64 / (6.0 * f64::from(calls))
+    );
+}
+
 /// Fuses a complete random network of `n` landmarks in one update: every relation of every
 /// triple is its true state plus `extra` random other states. Prints wall time, compositions,
 /// rounds, map heap bytes and process peak RSS; with `repeat > 1` the minimum and median wall
@@ -392,6 +425,10 @@ fn main() {
     }
     if args.render {
         bench_render(args.preview.as_deref());
+        return;
+    }
+    if let Some(calls) = args.triple_calls {
+        bench_triple_calls(calls, args.uncertainty);
         return;
     }
     if !args.measure.is_empty() {

@@ -1,6 +1,5 @@
 //! `pipeline run --images DIR`: panoramas in, qualitative map and RNG out (docs/RUN.md).
 
-use qrm_synth::evaluation::Evaluation;
 use super::pictures::{stage_pictures, PanoramaSize, RunImages};
 use super::rng_json;
 use super::rng_picture::{stage_rng_png, EdgeCut, DEFAULT_MAX_COST};
@@ -14,6 +13,7 @@ use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
 use qrm_core::neighborhood::RngEstimate;
 use qrm_plot::{spring_layout, write_panels, Curve, Panel};
+use qrm_synth::evaluation::Evaluation;
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::Channels;
 use qrm_vision::run::{
