@@ -40,7 +40,9 @@ def per_call(function, calls: int) -> float:
 def rust_triple(bench: Path, calls: int, uncertainty: float) -> float:
     out = subprocess.run(
         [str(bench), "--triple-calls", str(calls), "--uncertainty", str(uncertainty)],
-        capture_output=True, text=True, check=True,
+        capture_output=True,
+        text=True,
+        check=True,
     ).stdout
     return float(out.split(" µs each")[0].rsplit(", ", 1)[1]) * 1e-6
 
@@ -61,8 +63,15 @@ def main() -> None:
 
     # 1. Binding overhead of measure.
     for uncertainty, calls in ((0.0, 20000), (0.5, 1000)):
-        wrapper = per_call(lambda: qrm.measure([0.0, 40.0, 100.0], "A<B<C", uncertainty), calls)
-        native = per_call(lambda: _qrm.measure("edc", [0.0, 40.0, 100.0], "A<B<C", uncertainty), calls)
+
+        def wrapper_call(u=uncertainty):
+            return qrm.measure([0.0, 40.0, 100.0], "A<B<C", u)
+
+        def native_call(u=uncertainty):
+            return _qrm.measure("edc", [0.0, 40.0, 100.0], "A<B<C", u)
+
+        wrapper = per_call(wrapper_call, calls)
+        native = per_call(native_call, calls)
         rust = rust_triple(args.qrm_bench, calls, uncertainty)
         figures[f"measure ±{uncertainty}°"] = {
             "rust_us": rust * 1e6,
@@ -78,7 +87,8 @@ def main() -> None:
         start = time.perf_counter()
         subprocess.run(
             [str(args.pipeline), "simulate", "montecarlo", "--maps", str(args.maps), "--out", out],
-            capture_output=True, check=True,
+            capture_output=True,
+            check=True,
         )
         cli_seconds = time.perf_counter() - start
     start = time.perf_counter()

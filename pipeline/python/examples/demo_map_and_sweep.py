@@ -26,8 +26,10 @@ ROOT = Path(__file__).resolve().parents[3]
 # %% 1. Map the demo panoramas (the same files as `pipeline run`)
 def map_panoramas(images: Path, out: Path) -> qrm.Map:
     summary = qrm.run(images, out, progress=True)
-    print(f"{summary['landmarks']} landmarks from {summary['stations']} stations; "
-          f"{summary['rng_certain']} certain and {summary['rng_uncertain']} possible RNG edges")
+    print(
+        f"{summary['landmarks']} landmarks from {summary['stations']} stations; "
+        f"{summary['rng_certain']} certain and {summary['rng_uncertain']} possible RNG edges"
+    )
     return qrm.Map.load(out / "map.json")
 
 
@@ -44,16 +46,24 @@ def draw_rng(ax, m: qrm.Map) -> None:
     for edge in sorted(edges, key=lambda e: -e["cost"]):
         (x0, y0), (x1, y1) = where[edge["a"]], where[edge["b"]]
         certain = edge["cost"] == 0
-        ax.plot([x0, x1], [y0, y1], color="black" if certain else "tab:orange",
-                lw=2 if certain else 0.8, alpha=1 if certain else 0.5, zorder=1)
+        ax.plot(
+            [x0, x1],
+            [y0, y1],
+            color="black" if certain else "tab:orange",
+            lw=2 if certain else 0.8,
+            alpha=1 if certain else 0.5,
+            zorder=1,
+        )
     ax.scatter(layout["x"], layout["y"], s=60, color="tab:blue", zorder=2)
     for i, (x, y) in where.items():
         ax.annotate(str(i), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8)
     ax.plot([], [], color="black", lw=2, label="certain edge (w = 0)")
     ax.plot([], [], color="tab:orange", lw=0.8, label=f"possible edge (0 < w ≤ {MAX_COST})")
-    ax.set_title(f"(a) RNG of the demo map: {len(m)} landmarks, {len(edges)} of "
-                 f"{len(rng['edges'])} edges,\n"
-                 f"drawn on an {'exact' if layout['exact'] else 'approximate'} realization")
+    ax.set_title(
+        f"(a) RNG of the demo map: {len(m)} landmarks, {len(edges)} of "
+        f"{len(rng['edges'])} edges,\n"
+        f"drawn on an {'exact' if layout['exact'] else 'approximate'} realization"
+    )
     ax.set_xlabel("x (realization units)")
     ax.set_ylabel("y (realization units)")
     ax.set_aspect("equal")
@@ -62,8 +72,10 @@ def draw_rng(ax, m: qrm.Map) -> None:
 
 # %% 3. A small Fig. 7 sweep on a local cluster of two workers
 def small_sweep(ax, out: Path) -> None:
-    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None) as cluster,
+        Client(cluster) as client,
+    ):
         rows = batch.sweep(client=client, maps=8, stations=30, nearest=[6, 12, 30], chunk=4)
     table = batch.aggregate(rows)
     table.to_csv(out / "sweep.csv", index=False)

@@ -33,7 +33,9 @@ def deterministic(frame: pd.DataFrame) -> pd.DataFrame:
 def test_sweep_on_the_cluster_equals_the_sweep_in_process(client):
     local = batch.sweep(chunk=3, **STUDY)
     chunks = []
-    remote = batch.sweep(client=client, chunk=3, on_chunk=lambda d, t: chunks.append((d, t)), **STUDY)
+    remote = batch.sweep(
+        client=client, chunk=3, on_chunk=lambda d, t: chunks.append((d, t)), **STUDY
+    )
     assert len(local) == 2 * 5 * 6
     pd.testing.assert_frame_equal(deterministic(local), deterministic(remote), check_exact=True)
     assert chunks[-1] == (4, 4)
@@ -50,8 +52,20 @@ def test_sweep_rows_are_the_runs_of_simulate():
 
 
 def test_aggregate_reproduces_the_cli_csv(cli, tmp_path):
-    cli("simulate", "montecarlo", "--maps", 5, "--stations", 6, "--nearest", "6,9", "--seed", 3,
-        "--out", tmp_path)
+    cli(
+        "simulate",
+        "montecarlo",
+        "--maps",
+        5,
+        "--stations",
+        6,
+        "--nearest",
+        "6,9",
+        "--seed",
+        3,
+        "--out",
+        tmp_path,
+    )
     theirs = pd.read_csv(tmp_path / "montecarlo.csv", dtype={"n": str})
     mine = batch.aggregate(batch.sweep(**STUDY))
     assert list(mine.columns) == list(theirs.columns)

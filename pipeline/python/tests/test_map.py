@@ -57,8 +57,14 @@ def test_merge_matches_cli(simulated, cli, tmp_path):
     b = qrm.Map.load(simulated / "b" / "map.json")
     merged = a.copy()
     merged.merge(b)
-    cli("map", "merge", simulated / "a" / "map.json", simulated / "b" / "map.json",
-        "--out", tmp_path / "merged.json")
+    cli(
+        "map",
+        "merge",
+        simulated / "a" / "map.json",
+        simulated / "b" / "map.json",
+        "--out",
+        tmp_path / "merged.json",
+    )
     assert merged.to_json() == (tmp_path / "merged.json").read_text()
     assert a.to_json() == (simulated / "a" / "map.json").read_text(), "copy() is independent"
 
@@ -142,8 +148,16 @@ def test_bad_input_raises(call, error):
 def test_realize_matches_cli(simulated, cli, tmp_path):
     m = qrm.Map.load(simulated / "a" / "map.json")
     mine = m.realize(seed=2)
-    cli("map", "realize", simulated / "a" / "map.json", "--seed", 2, "--out", tmp_path / "r.json",
-        check=False)
+    cli(
+        "map",
+        "realize",
+        simulated / "a" / "map.json",
+        "--seed",
+        2,
+        "--out",
+        tmp_path / "r.json",
+        check=False,
+    )
     theirs = json.loads((tmp_path / "r.json").read_text())
     assert mine["exact"] == theirs["exact"] and mine["violated"] == theirs["violated"]
     assert list(mine["landmarks"]) == [p["landmark"] for p in theirs["landmarks"]]

@@ -118,12 +118,29 @@ def test_unknown_options_are_rejected_before_any_work(demo, tmp_path):
 
 
 def test_synth_renders_what_the_cli_renders(cli, tmp_path):
-    options = ["--preset", "random", "--seed", "4", "--stations", "2", "--rocks", "8",
-               "--scale", "0.25"]
+    options = [
+        "--preset",
+        "random",
+        "--seed",
+        "4",
+        "--stations",
+        "2",
+        "--rocks",
+        "8",
+        "--scale",
+        "0.25",
+    ]
     cli("synth", *options, "--out", tmp_path / "cli")
     calls = []
-    rendered = qrm.synth(tmp_path / "py", preset="random", seed=4, stations=2, rocks=8,
-                         scale=0.25, progress=lambda *a: calls.append(a))
+    rendered = qrm.synth(
+        tmp_path / "py",
+        preset="random",
+        seed=4,
+        stations=2,
+        rocks=8,
+        scale=0.25,
+        progress=lambda *a: calls.append(a),
+    )
     assert rendered["stations"] == 2 and rendered["rocks"] == 8
     assert calls[-1] == ("render", 2, 2)
     cli_files = sorted(p.name for p in (tmp_path / "cli").iterdir())

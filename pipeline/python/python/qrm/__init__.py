@@ -48,18 +48,29 @@ PathLike = Union[str, "os.PathLike[str]"]
 RELATION_NAMES = ("AB:C", "BC:A", "CA:B", "BA:C", "CB:A", "AC:B")
 
 
-def _relations_text(relations: Relations) -> str:
-    """A relation set as the command line writes it (``1,5,11``)."""
+def _members(relations: Relations) -> list:
+    """The relation numbers of a set given as numbers or as text (``"{1,5,11}"``)."""
     if isinstance(relations, str):
-        return relations
-    if isinstance(relations, (int, np.integer)):
-        relations = [relations]
+        try:
+            return [int(x) for x in relations.strip().strip("{}").split(",") if x.strip()]
+        except ValueError:
+            raise ValueError(f"relation set {relations!r} must list numbers, e.g. 1,5,11") from None
+    if isinstance(relations, (int, np.integer)) and not isinstance(relations, bool):
+        return [int(relations)]
     members = []
     for r in relations:
         if isinstance(r, bool) or not isinstance(r, (int, np.integer)):
             raise TypeError(f"relation {r!r} is not an integer relation number")
         members.append(int(r))
-    return "{" + ",".join(str(r) for r in sorted(set(members))) + "}"
+    return members
+
+
+def _relations_text(relations: Relations) -> str:
+    """A relation set as the command line writes it (``{1,5,11}``); text is passed on as it is,
+    for the command line's own parser and messages."""
+    if isinstance(relations, str):
+        return relations
+    return "{" + ",".join(str(r) for r in sorted(set(_members(relations)))) + "}"
 
 
 def _point(p: Any, name: str) -> Tuple[float, float]:
@@ -232,9 +243,10 @@ class Map:
         :class:`ContradictionError` and leaves the map exactly as it was."""
         batch = []
         for o in observations:
-            a, b, c, rel = o
-            members = _qrm_members(rel)
-            batch.append((int(a), int(b), int(c), members))
+            if len(o) != 4:
+                raise ValueError(f"observation {o!r} must be (a, b, c, relations)")
+            a, b, c, relations = o
+            batch.append((int(a), int(b), int(c), _members(relations)))
         return self._inner.fuse(batch)
 
     def fuse_view(
@@ -266,12 +278,15 @@ class Map:
         return json.loads(self._inner.rng_json())
 
     def realize(
-        self, seed: Optional[int] = None, sweeps: Optional[int] = None, restarts: Optional[int] = None
+        self,
+        seed: Optional[int] = None,
+        sweeps: Optional[int] = None,
+        restarts: Optional[int] = None,
     ) -> dict:
         """Positions under which every relation of the map holds, found by search as
         ``pipeline map realize`` does, with its defaults (a witness layout for drawing; the map
-        fixes no metric positions): ``{"landmarks", "x", "y"}`` as numpy arrays, ``exact`` (every constrained
-        relation holds), ``violated`` and ``constrained`` counts."""
+        fixes no metric positions): ``{"landmarks", "x", "y"}`` as numpy arrays, ``exact``
+        (every constrained relation holds), ``violated`` and ``constrained`` counts."""
         ids, x, y, violated, constrained = self._inner.realize(seed, sweeps, restarts)
         return {
             "landmarks": np.asarray(ids, dtype=np.uint32),
@@ -301,23 +316,6 @@ class Map:
         text, is_json = _network(network)
         consistent, tightened, conflict = _qrm.Map.check(text, calculus, is_json)
         return {"consistent": consistent, "tightened": tightened, "conflict": conflict}
-
-
-def _qrm_members(relations: Relations) -> list:
-    if isinstance(relations, str):
-        text = relations.strip().strip("{}")
-        try:
-            return [int(x) for x in text.split(",") if x.strip()]
-        except ValueError:
-            raise ValueError(f"relation set {relations!r} must list numbers, e.g. 1,5,11") from None
-    if isinstance(relations, (int, np.integer)):
-        return [int(relations)]
-    out = []
-    for r in relations:
-        if isinstance(r, bool) or not isinstance(r, (int, np.integer)):
-            raise TypeError(f"relation {r!r} is not an integer relation number")
-        out.append(int(r))
-    return out
 
 
 def _network(network: Any) -> Tuple[str, bool]:
@@ -440,7 +438,11 @@ def simulate(map_index: int, nearest: Optional[int] = None, **options: Any) -> d
         raise TypeError("give nearest as the run's own argument, not a study option")
     if isinstance(map_index, bool) or not isinstance(map_index, (int, np.integer)) or map_index < 0:
         raise ValueError(f"map_index must be a non-negative integer, got {map_index!r}")
-    if nearest is not None and (isinstance(nearest, bool) or not isinstance(nearest, (int, np.integer))):
+    if nearest is not None and (
+        isinstance(nearest, bool) or not isinstance(nearest, (int, np.integer))
+    ):
         raise TypeError(f"nearest must be an integer or None, got {nearest!r}")
-    columns = _qrm.montecarlo_run(_flags(options), int(map_index), None if nearest is None else int(nearest))
+    columns = _qrm.montecarlo_run(
+        _flags(options), int(map_index), None if nearest is None else int(nearest)
+    )
     return {name: np.asarray(columns[name]) for name in STEP_METRICS}
