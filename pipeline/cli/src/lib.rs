@@ -13,6 +13,7 @@ use qrm_core::calculus::{Calculus, CompositionFile, OperatorTables, RelationSet,
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
 use qrm_core::geometry::{boundary_values, Point};
+use std::process::ExitCode;
 
 pub mod commands;
 mod recording;
@@ -214,8 +215,9 @@ fn table_stats() {
     }
 }
 
-/// Runs one parsed command line.
-pub fn dispatch(cli: Cli) -> Result<()> {
+/// Runs one parsed command line; its exit status when it succeeds (1 for `map check` of an
+/// inconsistent network and a `map realize` that found no realization).
+pub fn dispatch(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Demo => demo(),
         Command::Classify { calculus, a, b, c } => {
@@ -242,12 +244,12 @@ pub fn dispatch(cli: Cli) -> Result<()> {
         Command::Tables => table_stats(),
         Command::Measure(args) => commands::measure::run(args)?,
         Command::Simulate(command) => commands::simulate::run_command(command)?,
-        Command::Map(command) => commands::map::run_command(command)?,
+        Command::Map(command) => return commands::map::run_command(command),
         Command::Navigate(command) => commands::navigate::run_command(command)?,
         Command::Synth(args) => commands::synth::run(args)?,
         Command::Run(args) => commands::run::run(args)?,
         Command::Directions(args) => commands::directions::run(&args)?,
         Command::Eval(args) => commands::eval::run(args)?,
     }
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

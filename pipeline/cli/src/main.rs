@@ -25,7 +25,7 @@ fn main() -> ExitCode {
     end_quietly_on_broken_pipe();
     interrupt::install();
     match dispatch(Cli::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(status) => status,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)

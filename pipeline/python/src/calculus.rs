@@ -5,7 +5,7 @@ use crate::errors;
 use clap::ValueEnum;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use qrm_cli::commands::measure::relations;
+use qrm_cli::commands::measure::{relations, RELATION_NAMES};
 use qrm_cli::commands::CalculusName;
 use qrm_cli::Operator;
 use qrm_core::calculus::RelationSet;
@@ -16,6 +16,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compose, m)?)?;
     m.add_function(wrap_pyfunction!(unary, m)?)?;
     m.add_function(wrap_pyfunction!(measure, m)?)?;
+    m.add("RELATION_NAMES", RELATION_NAMES)?;
     Ok(())
 }
 

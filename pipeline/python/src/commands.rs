@@ -13,6 +13,7 @@ use qrm_cli::commands::simulate::{study, SimulateCommand};
 use qrm_cli::commands::synth::render;
 use qrm_cli::commands::CalculusName;
 use qrm_cli::{Cli, Command};
+use qrm_core::calculus::Calculus;
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
 use qrm_core::simulation::Step;
@@ -36,7 +37,9 @@ fn parse(args: Vec<String>) -> PyResult<Command> {
 
 /// A Python progress function called from worker threads. The first exception it raises (a
 /// KeyboardInterrupt among them: signals are checked at every call) is kept, later calls are
-/// skipped, and the exception is raised once the command has finished.
+/// skipped, and the exception is raised once the command has finished. Python delivers
+/// signals to the main thread only: a KeyboardInterrupt is seen at the calls made there (the
+/// map stage of a run), not at those from worker threads (detection, rendering).
 struct Callback {
     function: Option<Py<PyAny>>,
     failure: Mutex<Option<PyErr>>,
@@ -50,29 +53,35 @@ impl Callback {
         })
     }
 
+    /// Calls the function with the GIL (which keeps calls one at a time). The lock guards
+    /// only the stored failure, never the call: the function may itself run parallel qrm
+    /// work on this thread pool.
     fn call(&self, stage: &str, done: usize, total: usize) {
         let Some(function) = &self.function else {
             return;
         };
-        let mut failure = self.failure.lock().expect("no panics hold it");
-        if failure.is_some() {
+        if self.failure.lock().expect("no panics hold it").is_some() {
             return;
         }
-        Python::attach(|py| {
-            let result = function
+        let result = Python::attach(|py| {
+            function
                 .call1(py, (stage, done, total))
-                .and_then(|_| py.check_signals());
-            if let Err(e) = result {
-                *failure = Some(e);
-            }
+                .and_then(|_| py.check_signals())
         });
+        if let Err(e) = result {
+            self.failure
+                .lock()
+                .expect("no panics hold it")
+                .get_or_insert(e);
+        }
     }
 
-    /// `result`, unless the callback failed.
-    fn finish<T>(&self, result: T) -> PyResult<T> {
+    /// `result`, unless the callback failed (its exception first: a KeyboardInterrupt it
+    /// caught is not lost behind the command's own error).
+    fn finish<T>(&self, result: PyResult<T>) -> PyResult<T> {
         match self.failure.lock().expect("no panics hold it").take() {
             Some(e) => Err(e),
-            None => Ok(result),
+            None => result,
         }
     }
 }
@@ -90,13 +99,11 @@ fn run(py: Python<'_>, args: Vec<String>, progress: Option<Py<PyAny>>) -> PyResu
         let callback = Arc::clone(&callback);
         Box::new(move |stage: &str, done, total| callback.call(stage, done, total)) as Box<Listener>
     });
-    let completed = py
-        .detach(|| execute(&args, listener))
-        .map_err(errors::qrm)?;
+    let completed = callback.finish(py.detach(|| execute(&args, listener)).map_err(errors::qrm))?;
     let mut summary = serde_json::to_value(&completed.summary)
         .map_err(|e| errors::QrmError::new_err(e.to_string()))?;
     summary["warnings"] = serde_json::json!(completed.warnings);
-    callback.finish(summary.to_string())
+    Ok(summary.to_string())
 }
 
 /// `pipeline synth ARGS…` without printing: what was rendered.
@@ -111,9 +118,10 @@ fn synth<'py>(
         return Err(PyValueError::new_err("not a synth command"));
     };
     let callback = Callback::new(progress);
-    let rendered = py
-        .detach(|| render(&args, &|done, total| callback.call("render", done, total)))
-        .map_err(errors::qrm)?;
+    let rendered = callback.finish(
+        py.detach(|| render(&args, &|done, total| callback.call("render", done, total)))
+            .map_err(errors::qrm),
+    )?;
     let d = PyDict::new(py);
     d.set_item("preset", rendered.preset)?;
     d.set_item("rocks", rendered.rocks)?;
@@ -123,7 +131,7 @@ fn synth<'py>(
     d.set_item("height", rendered.height)?;
     d.set_item("seconds", rendered.seconds)?;
     d.set_item("variant", rendered.variant)?;
-    callback.finish(d)
+    Ok(d)
 }
 
 /// The study `pipeline simulate montecarlo ARGS…` runs.
@@ -155,8 +163,8 @@ fn montecarlo_study<'py>(py: Python<'py>, args: Vec<String>) -> PyResult<Bound<'
 
 fn calculus_label(c: CalculusName) -> &'static str {
     match c {
-        CalculusName::Edc => "EDC",
-        CalculusName::Fdc => "FDC",
+        CalculusName::Edc => Edc::NAME,
+        CalculusName::Fdc => Fdc::NAME,
     }
 }
 

@@ -1,8 +1,9 @@
 //! `qrm._qrm`: the Python extension module, thin glue over `qrm_cli` and `qrm_core`
-//! (docs/PYTHON.md). Arguments arrive already checked and converted by the pure-Python layer
-//! (`python/qrm/__init__.py`: numpy arrays, keyword options as command-line flags); the work,
-//! its validation and its error messages are those of the `pipeline` command line. Long work
-//! runs with the GIL released; progress goes to an optional Python function.
+//! (docs/PYTHON.md). Arguments arrive converted by the pure-Python layer
+//! (`python/qrm/__init__.py`: numpy arrays to lists, keyword options to command-line flags,
+//! types and ranges of ids checked); the work, its validation and its error messages are those
+//! of the `pipeline` command line. Long work runs with the GIL released; progress goes to an
+//! optional Python function.
 
 mod calculus;
 mod commands;

@@ -229,18 +229,20 @@ impl Map {
     /// Every stored triple: (ids, masks) as little-endian uint32 buffers of shape (T, 3) —
     /// landmark ids (a, b, c) and the bitsets of AB:C, BC:A, CA:B (bit r−1 for relation r).
     fn relation_buffers<'py>(&self, py: Python<'py>) -> (Bound<'py, PyBytes>, Bound<'py, PyBytes>) {
-        let (ids, masks) = with_map!(&self.inner, m => {
-            let mut ids = Vec::with_capacity(m.triple_count() * 12);
-            let mut masks = Vec::with_capacity(m.triple_count() * 12);
-            for (a, b, c, sets) in m.triples() {
-                for id in [a, b, c] {
-                    ids.extend_from_slice(&id.to_le_bytes());
+        let (ids, masks) = py.detach(|| {
+            with_map!(&self.inner, m => {
+                let mut ids = Vec::with_capacity(m.triple_count() * 12);
+                let mut masks = Vec::with_capacity(m.triple_count() * 12);
+                for (a, b, c, sets) in m.triples() {
+                    for id in [a, b, c] {
+                        ids.extend_from_slice(&id.to_le_bytes());
+                    }
+                    for s in sets {
+                        masks.extend_from_slice(&s.bits().to_le_bytes());
+                    }
                 }
-                for s in sets {
-                    masks.extend_from_slice(&s.bits().to_le_bytes());
-                }
-            }
-            (ids, masks)
+                (ids, masks)
+            })
         });
         (PyBytes::new(py, &ids), PyBytes::new(py, &masks))
     }
@@ -304,11 +306,13 @@ impl Map {
     }
 
     /// The RNG estimate (000 §VII-A, Algorithm 2) as JSON text, as rng.json; EDC maps only.
-    fn rng_json(&self) -> PyResult<String> {
+    fn rng_json(&self, py: Python<'_>) -> PyResult<String> {
         match &self.inner {
-            Inner::Edc(m) => Ok(estimate(m)
-                .map(|rng| rng_json(m, &rng))
-                .expect("EDC has a lune")),
+            Inner::Edc(m) => Ok(py.detach(|| {
+                estimate(m)
+                    .map(|rng| rng_json(m, &rng))
+                    .expect("EDC has a lune")
+            })),
             Inner::Fdc(_) => Err(errors::QrmError::new_err(
                 "FDC maps have no RNG estimate (no lune)",
             )),

@@ -119,4 +119,10 @@ def test_traverse_globs_and_names(tmp_path, demo):
         batch.run_traverses(str(tmp_path / "nothing-*"), tmp_path / "out")
     with pytest.raises(ValueError):
         batch.run_traverses([], tmp_path / "out")
-    assert batch._output_names([tmp_path / "a" / "x", tmp_path / "b" / "x"]) == ["x-0", "x-1"]
+    names = batch._output_names(
+        [tmp_path / "a" / "sol", tmp_path / "b" / "sol", tmp_path / "sol-1"]
+    )
+    assert len(set(names)) == 3 and names[2] == "sol-1"
+    assert all(n.startswith("sol-") for n in names)
+    swapped = batch._output_names([tmp_path / "b" / "sol", tmp_path / "a" / "sol"])
+    assert swapped == [names[1], names[0]], "names do not depend on the order"

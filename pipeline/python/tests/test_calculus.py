@@ -86,3 +86,10 @@ def test_errors_carry_the_cli_message(cli):
         qrm.compose("1,21", "5")
     cli_error = cli("compose", "1,21", "5", check=False).stderr.strip()
     assert cli_error == f"error: {raised.value}"
+
+
+def test_measure_checks_the_uncertainty_in_degrees():
+    with pytest.raises(ValueError, match="degrees"):
+        qrm.measure([0, 40, 100], uncertainty=float("nan"))
+    with pytest.raises(ValueError, match="degrees"):
+        qrm.measure([0, 40, 100], uncertainty=-1)

@@ -2,6 +2,7 @@
 RNG — each against the command line on the same files."""
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -163,3 +164,45 @@ def test_realize_matches_cli(simulated, cli, tmp_path):
     assert list(mine["landmarks"]) == [p["landmark"] for p in theirs["landmarks"]]
     assert np.allclose(mine["x"], [p["x"] for p in theirs["landmarks"]])
     assert np.allclose(mine["y"], [p["y"] for p in theirs["landmarks"]])
+
+
+def test_close_and_check_take_a_maps_own_calculus():
+    m = qrm.Map("fdc")
+    m.fuse([(1, 2, 3, [1, 2, 3]), (1, 2, 4, [4, 5])])
+    assert qrm.Map.close(m).calculus == "FDC"
+    assert qrm.Map.check(m)["consistent"]
+
+
+def test_merging_a_map_with_itself_changes_nothing(simulated):
+    m = qrm.Map.load(simulated / "a" / "map.json")
+    before = m.to_json()
+    assert m.merge(m)["relations_tightened"] == 0
+    assert m.to_json() == before
+
+
+def test_saved_maps_get_the_usual_file_mode(tmp_path):
+    qrm.Map().save(tmp_path / "m.json")
+    umask = os.umask(0)
+    os.umask(umask)
+    assert (tmp_path / "m.json").stat().st_mode & 0o777 == 0o666 & ~umask
+
+
+@pytest.mark.parametrize(
+    "call,error",
+    [
+        (lambda m: m.fuse([(-1, 2, 3, [1])]), ValueError),
+        (lambda m: m.fuse([(2**32, 2, 3, [1])]), ValueError),
+        (lambda m: m.fuse([(1.7, 2, 3, [1])]), TypeError),
+        (lambda m: m.fuse([(1, 2, 3, [300])]), ValueError),
+        (lambda m: m.fuse([(1, 2, 3)]), ValueError),
+        (lambda m: m.relation(-1, 2, 3), ValueError),
+        (lambda m: m.fuse_view([1, 1, 2], [0, 1, 2]), ValueError),
+        (lambda m: m.fuse_view([1, 2, 3], [0, 1, 2], [(0, -1)]), ValueError),
+        (lambda m: m.fuse_view([1, 2, 3], [0, 1, 2], uncertainty=float("nan")), ValueError),
+        (lambda m: m.realize(seed=-1), ValueError),
+    ],
+)
+def test_ids_and_numbers_are_checked_before_rust(call, error):
+    with pytest.raises(error) as raised:
+        call(qrm.Map())
+    assert "OverflowError" not in type(raised.value).__name__ and str(raised.value)

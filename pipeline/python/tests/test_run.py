@@ -154,3 +154,17 @@ def test_synth_errors(tmp_path):
         qrm.synth(tmp_path / "o", preset="moon")
     with pytest.raises(qrm.QrmError, match="--rocks"):
         qrm.synth(tmp_path / "o", rocks=0)
+
+
+def test_options_take_negative_numbers_and_arrays():
+    import numpy as np
+
+    with pytest.raises(qrm.QrmError, match="--bearing-noise -0.5"):
+        qrm.montecarlo_study(bearing_noise=-0.5)
+    study = qrm.montecarlo_study(nearest=np.array([6, 9]))
+    assert study["nearest"] == [6, 9]
+    for reserved in ({"quiet": True}, {"help": True}, {"out": "x"}):
+        with pytest.raises(TypeError):
+            qrm.montecarlo_study(**reserved)
+    with pytest.raises(ValueError):
+        qrm.simulate(0, -1, maps=2)

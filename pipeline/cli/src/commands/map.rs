@@ -14,6 +14,7 @@ use qrm_core::map::{Hypergraph, Network, Observation, RealizeSettings};
 use qrm_core::neighborhood::estimate;
 use qrm_plot::Axes;
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 
 #[derive(Subcommand, Debug)]
 pub enum MapCommand {
@@ -101,7 +102,9 @@ pub(super) fn load<C: Calculus>(path: &Path, text: &str) -> Result<Hypergraph<C>
     Hypergraph::<C>::from_json(text).with_context(|| format!("invalid map {}", path.display()))
 }
 
-pub fn run_command(command: MapCommand) -> Result<()> {
+/// Runs a `map` command; `check` and `realize` end with status 1 when the network is
+/// inconsistent or no realization was found.
+pub fn run_command(command: MapCommand) -> Result<ExitCode> {
     match command {
         MapCommand::Info { file, rng } => {
             let text = read(&file)?;
@@ -110,6 +113,7 @@ pub fn run_command(command: MapCommand) -> Result<()> {
                 "FDC" => info(&load::<Fdc>(&file, &text)?, rng.as_deref()),
                 other => bail!("{}: unknown calculus {other:?}", file.display()),
             }
+            .map(|()| ExitCode::SUCCESS)
         }
         MapCommand::Close {
             file,
@@ -119,17 +123,15 @@ pub fn run_command(command: MapCommand) -> Result<()> {
             "EDC" => close::<Edc>(&file, &out),
             "FDC" => close::<Fdc>(&file, &out),
             other => bail!("{}: unknown calculus {other:?}", file.display()),
-        },
+        }
+        .map(|()| ExitCode::SUCCESS),
         MapCommand::Check { file, calculus } => {
             let consistent = match network_calculus(&file, calculus)?.as_str() {
                 "EDC" => check::<Edc>(&file)?,
                 "FDC" => check::<Fdc>(&file)?,
                 other => bail!("{}: unknown calculus {other:?}", file.display()),
             };
-            if !consistent {
-                std::process::exit(1);
-            }
-            Ok(())
+            Ok(status(consistent))
         }
         MapCommand::Realize {
             file,
@@ -171,10 +173,7 @@ pub fn run_command(command: MapCommand) -> Result<()> {
                 "FDC" => realize(&load::<Fdc>(&file, &text)?, &settings, &out, &picture, cut)?,
                 other => bail!("{}: unknown calculus {other:?}", file.display()),
             };
-            if !exact {
-                std::process::exit(1);
-            }
-            Ok(())
+            Ok(status(exact))
         }
         MapCommand::Merge { files, out } => {
             let text = read(&files[0])?;
@@ -183,7 +182,16 @@ pub fn run_command(command: MapCommand) -> Result<()> {
                 "FDC" => merge::<Fdc>(&files, &out),
                 other => bail!("{}: unknown calculus {other:?}", files[0].display()),
             }
+            .map(|()| ExitCode::SUCCESS)
         }
+    }
+}
+
+fn status(success: bool) -> ExitCode {
+    if success {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
     }
 }
 

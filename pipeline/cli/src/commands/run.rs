@@ -116,7 +116,8 @@ fn rng_drawing(map: &Hypergraph<Edc>, rng: &RngEstimate) -> RngDrawing {
 }
 
 /// A caller's progress function (the Python package's): `(stage, done, total)` with stage
-/// `detect` or `map`, called as each stage begins and after every station.
+/// `detect` or `map`, called as each stage begins and as each station is done, in order of
+/// `done`, from the thread that did the station.
 pub type Listener = dyn Fn(&str, usize, usize) + Send + Sync;
 
 /// Progress bars on the terminal, one per stage, or a caller's [`Listener`] instead; warnings
@@ -196,12 +197,10 @@ impl Progress for Bars {
 
     fn advance(&self) {
         if let Some(listener) = &self.listener {
-            let (stage, done, total) = {
-                let mut position = self.position.lock().expect("no panics hold it");
-                position.1 += 1;
-                *position
-            };
-            listener(stage, done, total);
+            // Called under the lock, so that counts reach the listener in order.
+            let mut position = self.position.lock().expect("no panics hold it");
+            position.1 += 1;
+            listener(position.0, position.1, position.2);
         }
         self.with_bar(|bar| bar.inc(1));
     }

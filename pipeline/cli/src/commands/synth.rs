@@ -8,7 +8,7 @@ use qrm_synth::dataset::{write_dataset, Counts, Preset, Request, Variant, Varian
 use qrm_synth::{default_calibration, Capture, Encoding, Scenery};
 use qrm_vision::calib::{Calibration, ColumnDirection};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// The presets as the command line spells them (`sparse-large`).
@@ -128,7 +128,9 @@ pub fn run(args: SynthArgs) -> Result<()> {
         .progress_chars("=> "),
     );
     let rendered = render(&args, &|done, total| {
-        bar.set_length(total as u64);
+        if bar.length() != Some(total as u64) {
+            bar.set_length(total as u64);
+        }
         bar.set_position(done as u64);
     })?;
     bar.finish_and_clear();
@@ -151,7 +153,7 @@ pub fn run(args: SynthArgs) -> Result<()> {
 }
 
 /// Renders the dataset `args` asks for into `args.out`; `progress(done, total)` after every
-/// station (and once with 0 at the start). Prints nothing.
+/// station, in order of `done` (and once with 0 at the start). Prints nothing.
 pub fn render(args: &SynthArgs, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<Rendered> {
     let base = match &args.calib {
         Some(path) => Calibration::load(path)?,
@@ -183,8 +185,13 @@ pub fn render(args: &SynthArgs, progress: &(dyn Fn(usize, usize) + Sync)) -> Res
         .stations
         .len();
     progress(0, stations);
-    let done = AtomicUsize::new(0);
-    let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, stations);
+    // Counted and reported under one lock, so that counts reach `progress` in order.
+    let done = Mutex::new(0usize);
+    let tick = || {
+        let mut done = done.lock().expect("no panics hold it");
+        *done += 1;
+        progress(*done, stations);
+    };
     let start = Instant::now();
     let truth = write_dataset(&args.out, &calib, request, &tick)
         .with_context(|| format!("rendering into {}", args.out.display()))?;

@@ -11,4 +11,4 @@ mod triplet;
 pub use belief::{Belief, STATES};
 pub use metrics::{dmse, entropy, gmd, gt_rating, Rating};
 pub use tensor::{CompositionTensor, RegionCentroids, TableError};
-pub use triplet::{estimate_baseline, estimate_fast, estimate_full, Noise, Prior, View};
+pub use triplet::{estimate_baseline, estimate_fast, estimate_full, Estimate, Noise, Prior, View};

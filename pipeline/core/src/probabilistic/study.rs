@@ -1,12 +1,13 @@
 //! 002's simulation (§IV; seed digest C.7, C.9): random triplets seen from three random camera
 //! poses with noisy bearings and motion commands, estimated by the full, fast and baseline
-//! algorithms, scored by DMSE, gmd and entropy; Table I's percentiles.
+//! algorithms, scored by DMSE, gmd and entropy; Table I's percentiles. The cameras' own states
+//! (Eq. 10) are scored the same way.
 
 use super::belief::Belief;
 use super::metrics::{dmse, entropy, gmd};
 use super::tensor::RegionCentroids;
 use super::triplet::{
-    angle_to, estimate_baseline, estimate_fast, estimate_full, wrap, Noise, Prior, View,
+    angle_to, estimate_baseline, estimate_fast, estimate_full, wrap, Estimate, Noise, Prior, View,
 };
 use crate::edc;
 use crate::geometry::Point;
@@ -39,29 +40,56 @@ pub struct StudySettings {
     pub seed: u64,
 }
 
-/// One algorithm's scores on one scenario.
+/// How close one belief is to the truth.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Score {
+pub struct Accuracy {
     pub dmse: f64,
     pub gmd: f64,
     pub entropy: f64,
+}
+
+impl Accuracy {
+    fn of(belief: &Belief, truth: u8, centroids: &RegionCentroids) -> Accuracy {
+        Accuracy {
+            dmse: dmse(belief, truth),
+            gmd: gmd(belief, truth, centroids),
+            entropy: entropy(belief),
+        }
+    }
+}
+
+/// One algorithm's scores on one scenario: `AB:C`, and each camera's `AB:X_n`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Score {
+    pub landmark: Accuracy,
+    pub cameras: Vec<Accuracy>,
     pub seconds: f64,
     /// The estimator returned nothing (no particle survived): scored as the uniform belief.
     pub failed: bool,
 }
 
 /// The three algorithms' scores on one scenario.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Outcome {
     pub truth: u8,
+    /// The true `AB:X_n` of each camera.
+    pub cameras: Vec<u8>,
     pub baseline: Score,
     pub full: Score,
     pub fast: Score,
 }
 
-/// A random triplet and camera poses in the box, the views with noise, the truth `AB:C`, and
-/// the box in the AB frame (the baseline's prior).
-pub fn scenario(settings: &StudySettings, rng: &mut impl Rng) -> (Vec<View>, u8, Prior) {
+/// One scenario: the views with noise, the truth `AB:C` and each camera's `AB:X_n`, and the
+/// box in the AB frame (the estimators' prior).
+pub struct Triplet {
+    pub views: Vec<View>,
+    pub truth: u8,
+    pub cameras: Vec<u8>,
+    pub prior: Prior,
+}
+
+/// A random triplet and camera poses in the box (none on a region boundary).
+pub fn scenario(settings: &StudySettings, rng: &mut impl Rng) -> Triplet {
     let point = |rng: &mut dyn rand::RngCore| {
         Point::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..4.0))
     };
@@ -73,6 +101,13 @@ pub fn scenario(settings: &StudySettings, rng: &mut impl Rng) -> (Vec<View>, u8,
         let poses: Vec<(Point, f64)> = (0..settings.views)
             .map(|_| (point(rng), rng.random_range(0.0..TAU)))
             .collect();
+        let Some(cameras) = poses
+            .iter()
+            .map(|&(x, _)| edc::classify(a, b, x))
+            .collect::<Option<Vec<u8>>>()
+        else {
+            continue;
+        };
         let bearing_noise = Normal::new(0.0, settings.noise.bearing).expect("finite s.d.");
         let motion_noise = Normal::new(0.0, settings.noise.motion).expect("finite s.d.");
         let views: Vec<View> = poses
@@ -89,20 +124,37 @@ pub fn scenario(settings: &StudySettings, rng: &mut impl Rng) -> (Vec<View>, u8,
             .collect();
         // The box in the frame A = (0,0), B = (0,1).
         let polygon = BOX.iter().map(|p| p.in_frame(a, b)).collect();
-        return (views, truth, Prior { polygon });
+        return Triplet {
+            views,
+            truth,
+            cameras,
+            prior: Prior { polygon },
+        };
     }
 }
 
-fn score(run: impl FnOnce() -> Option<Belief>, truth: u8, centroids: &RegionCentroids) -> Score {
+/// Runs one estimator and scores it; a failed estimate counts as uniform beliefs.
+fn score(
+    run: impl FnOnce() -> Option<Estimate>,
+    triplet: &Triplet,
+    centroids: &RegionCentroids,
+) -> Score {
     let started = Instant::now();
-    let belief = run();
+    let estimate = run();
     let seconds = started.elapsed().as_secs_f64();
-    let failed = belief.is_none();
-    let belief = belief.unwrap_or_else(Belief::uniform);
+    let failed = estimate.is_none();
+    let estimate = estimate.unwrap_or_else(|| Estimate {
+        landmark: Belief::uniform(),
+        cameras: vec![Belief::uniform(); triplet.cameras.len()],
+    });
     Score {
-        dmse: dmse(&belief, truth),
-        gmd: gmd(&belief, truth, centroids),
-        entropy: entropy(&belief),
+        landmark: Accuracy::of(&estimate.landmark, triplet.truth, centroids),
+        cameras: estimate
+            .cameras
+            .iter()
+            .zip(&triplet.cameras)
+            .map(|(belief, &truth)| Accuracy::of(belief, truth, centroids))
+            .collect(),
         seconds,
         failed,
     }
@@ -116,41 +168,43 @@ pub fn run_study(settings: &StudySettings, progress: &(dyn Fn() + Sync)) -> Vec<
         .map(|k| {
             let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
             rng.set_stream(k as u64);
-            let (views, truth, prior) = scenario(settings, &mut rng);
+            let triplet = scenario(settings, &mut rng);
+            let (views, prior) = (&triplet.views, &triplet.prior);
             let baseline = score(
-                || estimate_baseline(&views, &prior, settings.baseline_samples, &mut rng),
-                truth,
+                || estimate_baseline(views, prior, settings.baseline_samples, &mut rng),
+                &triplet,
                 &centroids,
             );
             let full = score(
                 || {
                     estimate_full(
-                        &views,
-                        &prior,
+                        views,
+                        prior,
                         settings.noise,
                         settings.full_particles,
                         &mut rng,
                     )
                 },
-                truth,
+                &triplet,
                 &centroids,
             );
             let fast = score(
                 || {
                     estimate_fast(
-                        &views,
-                        &prior,
+                        views,
+                        prior,
                         settings.noise.bearing,
                         settings.fast_particles,
                         &mut rng,
                     )
                 },
-                truth,
+                &triplet,
                 &centroids,
             );
             progress();
             Outcome {
-                truth,
+                truth: triplet.truth,
+                cameras: triplet.cameras,
                 baseline,
                 full,
                 fast,
@@ -193,12 +247,21 @@ mod tests {
             quartiles(&mut v)[1]
         };
         let (full, fast, base) = (
-            median(&|o| o.full.dmse),
-            median(&|o| o.fast.dmse),
-            median(&|o| o.baseline.dmse),
+            median(&|o| o.full.landmark.dmse),
+            median(&|o| o.fast.landmark.dmse),
+            median(&|o| o.baseline.landmark.dmse),
         );
         assert!(full < 0.05 && fast < 0.05, "full {full}, fast {fast}");
         assert!(base > full, "baseline {base}");
+        // Eq. (10): without noise the cameras are localized as well.
+        let camera = |f: &dyn Fn(&Outcome) -> &Score| {
+            let mut v: Vec<f64> = outcomes
+                .iter()
+                .flat_map(|o| f(o).cameras.iter().map(|a| a.dmse))
+                .collect();
+            quartiles(&mut v)[1]
+        };
+        assert!(camera(&|o| &o.full) < 0.05 && camera(&|o| &o.fast) < 0.05);
         assert_eq!(quartiles(&mut [4.0, 1.0, 3.0, 2.0]), [1.0, 2.0, 3.0]);
     }
 }

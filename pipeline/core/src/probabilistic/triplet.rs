@@ -14,6 +14,10 @@
 //! - [`estimate_baseline`]: 002 §III-F, after Padgett & Campbell: each view alone (pose on its
 //!   locus, `C` anywhere along its bearing ray within the prior's support), views multiplied
 //!   as if independent.
+//!
+//! Each returns an [`Estimate`]: the belief over `AB:C` (002 Eq. 9) and, for every view, the
+//! belief over the camera's own state `AB:X_n` — the qualitative camera localization of
+//! Eq. (7), (10) — from the same weighted particles.
 
 use super::belief::{Belief, STATES};
 use crate::edc;
@@ -75,6 +79,21 @@ impl Prior {
         }
         (t0 < t1 && t1.is_finite()).then_some((t0, t1))
     }
+}
+
+/// The beliefs an estimator returns: `AB:C` (Eq. 9) and `AB:X_n` for each view (Eq. 10).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Estimate {
+    pub landmark: Belief,
+    pub cameras: Vec<Belief>,
+}
+
+/// One particle: `C`, the camera positions of the views, and the log-likelihood of `C`'s
+/// bearings.
+struct Particle {
+    c: Point,
+    cameras: Vec<Point>,
+    log_weight: f64,
 }
 
 const A: Point = Point::new(0.0, 0.0);
@@ -184,7 +203,7 @@ fn particle(
     noise: Option<Noise>,
     bearing_sd: f64,
     rng: &mut impl Rng,
-) -> Option<(Point, f64)> {
+) -> Option<Particle> {
     let jitter = |sd: f64, rng: &mut dyn rand::RngCore| match noise {
         Some(_) if sd > 0.0 => Normal::new(0.0, sd).expect("finite s.d.").sample(rng),
         _ => 0.0,
@@ -215,22 +234,44 @@ fn particle(
         .zip(&phi_c)
         .map(|(&(x, alpha), &phi)| log_gaussian(wrap(angle_to(x, c) - alpha - phi), bearing_sd))
         .sum();
-    Some((c, log_weight))
+    Some(Particle {
+        c,
+        cameras: poses.iter().map(|p| p.0).collect(),
+        log_weight,
+    })
 }
 
-/// The weighted histogram of `C`'s region over particles `(C, ln weight)`.
-fn histogram(samples: &[(Point, f64)]) -> Option<Belief> {
-    let top = samples
+/// Adds `weight` to the region of `p` (nothing on a boundary).
+fn add(weights: &mut [f64; STATES], p: Point, weight: f64) {
+    if let Some(r) = edc::classify(A, B, p) {
+        weights[r as usize - 1] += weight;
+    }
+}
+
+/// The weighted histograms of `C`'s region and of each camera's over the particles (Eq. 9,
+/// 10); `None` when no particle has weight. A camera whose particles all sit on boundaries
+/// gets the uniform belief.
+fn histogram(particles: &[Particle], views: usize) -> Option<Estimate> {
+    let top = particles
         .iter()
-        .map(|s| s.1)
+        .map(|p| p.log_weight)
         .fold(f64::NEG_INFINITY, f64::max);
-    let mut weights = [0.0; STATES];
-    for &(c, log_w) in samples {
-        if let Some(r) = edc::classify(A, B, c) {
-            weights[r as usize - 1] += (log_w - top).exp();
+    let mut landmark = [0.0; STATES];
+    let mut cameras = vec![[0.0; STATES]; views];
+    for p in particles {
+        let w = (p.log_weight - top).exp();
+        add(&mut landmark, p.c, w);
+        for (weights, &x) in cameras.iter_mut().zip(&p.cameras) {
+            add(weights, x, w);
         }
     }
-    Belief::from_weights(weights)
+    Some(Estimate {
+        landmark: Belief::from_weights(landmark)?,
+        cameras: cameras
+            .into_iter()
+            .map(|w| Belief::from_weights(w).unwrap_or_else(Belief::uniform))
+            .collect(),
+    })
 }
 
 /// 002 Algorithm 1 with `particles` particles; `None` when no particle survives (no pose
@@ -241,11 +282,11 @@ pub fn estimate_full(
     noise: Noise,
     particles: usize,
     rng: &mut impl Rng,
-) -> Option<Belief> {
-    let samples: Vec<(Point, f64)> = (0..particles)
+) -> Option<Estimate> {
+    let samples: Vec<Particle> = (0..particles)
         .filter_map(|_| particle(views, prior, Some(noise), noise.bearing, rng))
         .collect();
-    histogram(&samples)
+    histogram(&samples, views.len())
 }
 
 /// 002 §III-D: the prior sampled along the exact first locus, everything else exact, the
@@ -256,28 +297,31 @@ pub fn estimate_fast(
     bearing_sd: f64,
     particles: usize,
     rng: &mut impl Rng,
-) -> Option<Belief> {
-    let samples: Vec<(Point, f64)> = (0..particles)
+) -> Option<Estimate> {
+    let samples: Vec<Particle> = (0..particles)
         .filter_map(|_| particle(views, prior, None, bearing_sd, rng))
         .collect();
-    histogram(&samples)
+    histogram(&samples, views.len())
 }
 
 /// 002 §III-F: each view estimated alone — pose on its exact locus, `C` uniform along its
 /// bearing ray within `prior` — and the views' beliefs multiplied. A view whose rays all miss
 /// the prior is left out. Each view's histogram is floored at `1e-3` of its mass before the
-/// product, so that one view's empty state does not veto the others (002 does not say).
+/// product, so that one view's empty state does not veto the others (002 does not say). Each
+/// camera's belief is its view's own: poses on the locus, weighted alike.
 pub fn estimate_baseline(
     views: &[View],
     prior: &Prior,
     samples_per_view: usize,
     rng: &mut impl Rng,
-) -> Option<Belief> {
+) -> Option<Estimate> {
     let mut product = [1.0; STATES];
     let mut used = 0;
+    let mut cameras = Vec::with_capacity(views.len());
     for view in views {
         let gamma = wrap(view.bearings[1] - view.bearings[0]);
         let mut weights = [0.0; STATES];
+        let mut camera = [0.0; STATES];
         for _ in 0..samples_per_view {
             let Some(x) = (0..32).find_map(|_| locus_point(gamma, rng.random::<f64>() * TAU))
             else {
@@ -287,13 +331,13 @@ pub fn estimate_baseline(
             if let Some((t0, t1)) = prior.clip(x, dir) {
                 let t = t0 + rng.random::<f64>() * (t1 - t0);
                 let c = Point::new(x.x + t * dir.x, x.y + t * dir.y);
-                if let Some(r) = edc::classify(A, B, c) {
-                    // Weighted by the ray's length inside the prior: uniform over the region
-                    // the view allows.
-                    weights[r as usize - 1] += t1 - t0;
-                }
+                // Weighted by the ray's length inside the prior: uniform over the region the
+                // view allows.
+                add(&mut weights, c, t1 - t0);
+                add(&mut camera, x, t1 - t0);
             }
         }
+        cameras.push(Belief::from_weights(camera).unwrap_or_else(Belief::uniform));
         let Some(view_belief) = Belief::from_weights(weights) else {
             continue;
         };
@@ -305,7 +349,10 @@ pub fn estimate_baseline(
     if used == 0 {
         return None;
     }
-    Belief::from_weights(product)
+    Some(Estimate {
+        landmark: Belief::from_weights(product)?,
+        cameras,
+    })
 }
 
 #[cfg(test)]
@@ -359,7 +406,11 @@ mod tests {
             ],
         };
         let fast = estimate_fast(&v, &prior, 0.5f64.to_radians(), 500, &mut rng).unwrap();
-        assert_eq!(fast.most_likely(), truth);
+        assert_eq!(fast.landmark.most_likely(), truth);
+        // Eq. (10): every camera's own region comes first too.
+        for (belief, &(x, _)) in fast.cameras.iter().zip(&poses) {
+            assert_eq!(belief.most_likely(), edc::classify(A, B, x).unwrap());
+        }
         let full = estimate_full(
             &v,
             &prior,
@@ -371,8 +422,15 @@ mod tests {
             &mut rng,
         )
         .unwrap();
-        assert_eq!(full.most_likely(), truth);
+        assert_eq!(full.landmark.most_likely(), truth);
+        for (belief, &(x, _)) in full.cameras.iter().zip(&poses) {
+            assert_eq!(belief.most_likely(), edc::classify(A, B, x).unwrap());
+        }
         let baseline = estimate_baseline(&v, &prior, 2000, &mut rng).unwrap();
-        assert!(baseline.probability(truth) > 0.0);
+        assert!(baseline.landmark.probability(truth) > 0.0);
+        assert_eq!(baseline.cameras.len(), 3);
+        for (belief, &(x, _)) in baseline.cameras.iter().zip(&poses) {
+            assert!(belief.probability(edc::classify(A, B, x).unwrap()) > 0.0);
+        }
     }
 }

@@ -2,6 +2,7 @@
 //! model that measures from true geometry, mapping runs scored after every image, and the
 //! Monte Carlo study of Fig. 7.
 
+pub mod beliefs;
 mod mapping;
 mod montecarlo;
 mod navigation;

@@ -23,7 +23,7 @@ from typing import Any, Callable, Iterable, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _qrm
-from ._qrm import ContradictionError, QrmError, __version__
+from ._qrm import RELATION_NAMES, ContradictionError, QrmError, __version__
 
 __all__ = [
     "ContradictionError",
@@ -44,9 +44,6 @@ Relations = Union[int, str, Iterable[int]]
 Progress = Union[None, bool, Callable[[str, int, int], Any]]
 PathLike = Union[str, "os.PathLike[str]"]
 
-#: The relations :func:`measure` returns, in order.
-RELATION_NAMES = ("AB:C", "BC:A", "CA:B", "BA:C", "CB:A", "AC:B")
-
 
 def _members(relations: Relations) -> list:
     """The relation numbers of a set given as numbers or as text (``"{1,5,11}"``)."""
@@ -61,8 +58,37 @@ def _members(relations: Relations) -> list:
     for r in relations:
         if isinstance(r, bool) or not isinstance(r, (int, np.integer)):
             raise TypeError(f"relation {r!r} is not an integer relation number")
+        if not 1 <= r <= 32:
+            raise ValueError(f"relation {r} is outside 1..=20 (EDC) and 1..=15 (FDC)")
         members.append(int(r))
     return members
+
+
+def _id(x: Any, what: str = "landmark id") -> int:
+    """A landmark id: an integer in 0..2³²."""
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
+        raise TypeError(f"{what} {x!r} must be an integer")
+    if not 0 <= x < 2**32:
+        raise ValueError(f"{what} {x} must lie in 0..2^32")
+    return int(x)
+
+
+def _degrees(value: Any, name: str) -> float:
+    """A non-negative finite angle in degrees."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be a number of degrees, got {value!r}")
+    if not (np.isfinite(value) and value >= 0):
+        raise ValueError(f"{name} must be a finite, non-negative number of degrees, got {value}")
+    return float(value)
+
+
+def _count(value: Any, name: str) -> Optional[int]:
+    """A non-negative integer, or None."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise ValueError(f"{name} must be a non-negative integer, got {value!r}")
+    return int(value)
 
 
 def _relations_text(relations: Relations) -> str:
@@ -144,18 +170,23 @@ def measure(
     b = _numbers(bearings, "bearings")
     if b.shape != (3,):
         raise ValueError(f"bearings must hold three angles, got shape {b.shape}")
-    sets = _qrm.measure(calculus, b.tolist(), _order_text(order), float(uncertainty))
+    sets = _qrm.measure(
+        calculus, b.tolist(), _order_text(order), _degrees(uncertainty, "uncertainty")
+    )
     return {name: frozenset(s) for name, s in zip(RELATION_NAMES, sets)}
 
 
 def _write_atomic(path: PathLike, text: str) -> None:
     """Writes ``text`` to ``path`` whole or not at all (a temporary file renamed)."""
     path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=directory)
+    fd, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write(text)
+        # mkstemp's file is private (0600); give it the mode a plain open() would.
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)
         os.replace(temporary, path)
     except BaseException:
         if os.path.exists(temporary):
@@ -224,7 +255,7 @@ class Map:
 
     def relation(self, a: int, b: int, c: int) -> Optional[frozenset]:
         """The possible relations AB:C; ``None`` if a landmark is not in the map."""
-        r = self._inner.relation(a, b, c)
+        r = self._inner.relation(_id(a), _id(b), _id(c))
         return None if r is None else frozenset(r)
 
     def relations(self) -> Tuple[np.ndarray, np.ndarray]:
@@ -246,7 +277,7 @@ class Map:
             if len(o) != 4:
                 raise ValueError(f"observation {o!r} must be (a, b, c, relations)")
             a, b, c, relations = o
-            batch.append((int(a), int(b), int(c), _members(relations)))
+            batch.append((_id(a), _id(b), _id(c), _members(relations)))
         return self._inner.fuse(batch)
 
     def fuse_view(
@@ -262,15 +293,23 @@ class Map:
         b = _numbers(bearings, "bearings")
         if b.ndim != 1:
             raise ValueError(f"bearings must be one angle per landmark, got shape {b.shape}")
-        ids = [int(x) for x in np.asarray(landmarks).ravel()]
-        pairs = [(int(i), int(j)) for i, j in order]
-        return self._inner.fuse_view(ids, b.tolist(), pairs, float(uncertainty))
+        ids = [_id(x) for x in landmarks]
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"landmarks {ids} name a landmark twice")
+        pairs = []
+        for pair in order:
+            if len(pair) != 2:
+                raise ValueError(f"range-order pair {pair!r} must be (nearer, farther)")
+            pairs.append(tuple(_id(i, "range-order position") for i in pair))
+        return self._inner.fuse_view(ids, b.tolist(), pairs, _degrees(uncertainty, "uncertainty"))
 
     def merge(self, other: "Map") -> dict:
         """Fuses another map of the same calculus (landmarks matched by id)."""
         if not isinstance(other, Map):
             raise TypeError(f"can only merge a qrm.Map, not {type(other).__name__}")
-        return self._inner.merge(other._inner)
+        # A map is borrowed mutably while it merges: merging it with itself takes a copy.
+        source = other._inner.copy() if other is self else other._inner
+        return self._inner.merge(source)
 
     def rng(self) -> dict:
         """The RNG estimate (000 §VII-A, Algorithm 2), as rng.json: edges with cost w (0 =
@@ -287,7 +326,9 @@ class Map:
         ``pipeline map realize`` does, with its defaults (a witness layout for drawing; the map
         fixes no metric positions): ``{"landmarks", "x", "y"}`` as numpy arrays, ``exact``
         (every constrained relation holds), ``violated`` and ``constrained`` counts."""
-        ids, x, y, violated, constrained = self._inner.realize(seed, sweeps, restarts)
+        ids, x, y, violated, constrained = self._inner.realize(
+            _count(seed, "seed"), _count(sweeps, "sweeps"), _count(restarts, "restarts")
+        )
         return {
             "landmarks": np.asarray(ids, dtype=np.uint32),
             "x": np.asarray(x),
@@ -304,9 +345,12 @@ class Map:
     def close(cls, network: Union["Map", str, "os.PathLike[str]"], calculus: str = "edc") -> "Map":
         """Closes a constraint network to full path consistency, as ``pipeline map close``:
         a :class:`Map`, a file (``pathlib.Path``; ``.json`` maps, otherwise one ``A B C {r,…}``
-        per line), or network text. An inconsistent network raises
+        per line), or network text; a Map's own calculus replaces ``calculus``. An inconsistent
+        network raises
         :class:`ContradictionError` naming a minimal set of conflicting constraints."""
         text, is_json = _network(network)
+        if isinstance(network, Map):
+            calculus = network.calculus
         return cls._wrap(_qrm.Map.close(text, calculus, is_json))
 
     @staticmethod
@@ -314,6 +358,8 @@ class Map:
         """Checks a constraint network, as ``pipeline map check``: ``{"consistent": bool,
         "tightened": int, "conflict": str}``."""
         text, is_json = _network(network)
+        if isinstance(network, Map):
+            calculus = network.calculus
         consistent, tightened, conflict = _qrm.Map.check(text, calculus, is_json)
         return {"consistent": consistent, "tightened": tightened, "conflict": conflict}
 
@@ -332,22 +378,26 @@ def _network(network: Any) -> Tuple[str, bool]:
     raise TypeError("a network is a qrm.Map, a pathlib.Path or text")
 
 
-def _flags(options: dict) -> list:
+def _flags(options: dict, reserved: Sequence[str] = ()) -> list:
     """Keyword options as command-line flags: ``no_eval=True`` → ``--no-eval``, ``seed=3`` →
-    ``--seed 3``, lists joined by commas; ``False`` and ``None`` leave the flag out."""
+    ``--seed=3``, lists and arrays joined by commas; ``False`` and ``None`` leave the flag out.
+    Options the function sets itself (``reserved``) or that only make sense on a terminal are
+    refused."""
     argv = []
     for key, value in options.items():
+        if key in ("help", "version", "quiet", *reserved):
+            raise TypeError(f"{key} is not an option here")
         flag = "--" + key.replace("_", "-")
         if value is None or value is False:
             continue
         if value is True:
             argv.append(flag)
-        elif isinstance(value, (list, tuple)):
-            argv += [flag, ",".join(str(v) for v in value)]
+        elif isinstance(value, (list, tuple, np.ndarray)):
+            argv.append(f"{flag}=" + ",".join(str(v) for v in np.asarray(value).ravel().tolist()))
         elif isinstance(value, os.PathLike):
-            argv += [flag, os.fspath(value)]
+            argv.append(f"{flag}={os.fspath(value)}")
         else:
-            argv += [flag, str(value)]
+            argv.append(f"{flag}={value}")
     return argv
 
 
@@ -379,9 +429,6 @@ def run(images: PathLike, out: PathLike, *, progress: Progress = None, **options
     Errors raise :class:`QrmError` with the command line's message; nothing half-written is
     left behind.
     """
-    for name in ("images", "out"):
-        if name in options:
-            raise TypeError(f"{name} is a positional argument")
     argv = ["run", "--images", os.fspath(images), "--out", os.fspath(out), "--quiet"]
     argv += _flags(options)
     return json.loads(_qrm.run(argv, _progress(progress)))
@@ -409,7 +456,7 @@ def montecarlo_study(**options: Any) -> dict:
     (``study="fig7"`` or ``"dissertation"``, ``maps``, ``stations``, ``nearest=[6, 9]``,
     ``calculus``, ``seed``, ``bearing_noise``, ``order_swaps``): its calculus, maps,
     landmarks, stations, side, series (``nearest``; ``None`` = all) and seed."""
-    return _qrm.montecarlo_study(_flags(options))
+    return _qrm.montecarlo_study(_flags(options, reserved=("out",)))
 
 
 #: The per-image metrics :func:`simulate` returns.
@@ -434,15 +481,9 @@ def simulate(map_index: int, nearest: Optional[int] = None, **options: Any) -> d
     the ``nearest`` landmarks seen at each imaging point (``None``: all). Returns one numpy
     array per metric of :data:`STEP_METRICS`, one value per image; ``seconds`` is wall time
     (the only value that differs between two runs)."""
-    if "nearest" in options:
-        raise TypeError("give nearest as the run's own argument, not a study option")
-    if isinstance(map_index, bool) or not isinstance(map_index, (int, np.integer)) or map_index < 0:
-        raise ValueError(f"map_index must be a non-negative integer, got {map_index!r}")
-    if nearest is not None and (
-        isinstance(nearest, bool) or not isinstance(nearest, (int, np.integer))
-    ):
-        raise TypeError(f"nearest must be an integer or None, got {nearest!r}")
     columns = _qrm.montecarlo_run(
-        _flags(options), int(map_index), None if nearest is None else int(nearest)
+        _flags(options, reserved=("out",)),
+        _count(map_index, "map_index"),
+        _count(nearest, "nearest"),
     )
     return {name: np.asarray(columns[name]) for name in STEP_METRICS}

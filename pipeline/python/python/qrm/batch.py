@@ -17,6 +17,7 @@ the other: the same tasks and the same results, which is how a sweep on a cluste
 from __future__ import annotations
 
 import glob as globbing
+import hashlib
 import json
 import os
 import time
@@ -53,12 +54,19 @@ def _traverse_dirs(traverses: Union[str, "os.PathLike[str]", Iterable[Any]]) -> 
 
 
 def _output_names(dirs: Sequence[Path]) -> List[str]:
-    """One output directory name per traverse: its own name, made unique with its index."""
+    """One output directory name per traverse: its own name, or, where names collide, the name
+    with a short hash of its full path — stable whatever the order of the list, so that a
+    resumed batch finds its outputs again."""
     names = [d.name or "traverse" for d in dirs]
-    seen: dict = {}
+    count: dict = {}
     for n in names:
-        seen[n] = seen.get(n, 0) + 1
-    return [n if seen[n] == 1 else f"{n}-{i}" for i, n in enumerate(names)]
+        count[n] = count.get(n, 0) + 1
+    return [
+        n
+        if count[n] == 1
+        else f"{n}-{hashlib.sha1(os.fspath(d.resolve()).encode()).hexdigest()[:8]}"
+        for n, d in zip(names, dirs)
+    ]
 
 
 def traverse_outputs_complete(out: Union[str, "os.PathLike[str]"]) -> bool:

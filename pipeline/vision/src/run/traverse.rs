@@ -137,12 +137,12 @@ pub fn map_stations<C: Calculus, E>(
     let mut skipped = Vec::new();
     progress.begin(Stage::Map, detected.stations.len());
     for result in &detected.stations {
-        progress.advance();
         let station = match &result.station {
             Ok(station) => station,
             Err(warning) => {
                 progress.warn(warning);
                 skipped.push(warning.clone());
+                progress.advance();
                 continue;
             }
         };
@@ -156,6 +156,7 @@ pub fn map_stations<C: Calculus, E>(
         on_station(&record, &mapper)?;
         record.seconds.recording = recording.elapsed().as_secs_f64();
         records.push(record);
+        progress.advance();
     }
     progress.end();
     Ok(Traverse {
