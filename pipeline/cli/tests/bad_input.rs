@@ -1546,6 +1546,21 @@ fn directions_cases() -> Vec<Case> {
             &["--bearing-noise"],
         ),
         Case::new(
+            "simulate single --mode probabilistic: one view cannot resect",
+            "simulate single --mode probabilistic --views 1 --out {dir}/s",
+            &["--views"],
+        ),
+        Case::new(
+            "simulate single --mode probabilistic: no particles",
+            "simulate single --mode probabilistic --particles 0 --out {dir}/s",
+            &["--particles"],
+        ),
+        Case::new(
+            "simulate single --mode probabilistic: motion noise out of range",
+            "simulate single --mode probabilistic --motion-noise 90 --out {dir}/s",
+            &["--motion-noise"],
+        ),
+        Case::new(
             "simulate directions: no trials",
             "simulate directions --trials 0 --out {dir}/study",
             &["--trials and --routes must be positive"],

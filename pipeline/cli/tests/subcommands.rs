@@ -432,4 +432,57 @@ fn probabilistic_table_one() {
     let outcomes: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("outcomes.json")).unwrap()).unwrap();
     assert_eq!(outcomes.as_array().unwrap().len(), 6);
+    // Eq. (10): each of the 3 cameras is scored.
+    assert_eq!(outcomes[0]["full"]["cameras"].as_array().unwrap().len(), 3);
+    assert!(
+        rows[1]["camera"]["dmse"][1].as_f64().unwrap() < 0.05,
+        "{}",
+        rows[1]
+    );
+}
+
+/// `simulate single --mode probabilistic` writes 002's beliefs beside the map, keyed by the
+/// map's landmark ids and normalized; the FDC is refused before any work.
+#[test]
+fn probabilistic_simulated_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s");
+    let o = pipeline(&[
+        "simulate",
+        "single",
+        "--mode",
+        "probabilistic",
+        "--landmarks",
+        "8",
+        "--stations",
+        "6",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(stdout(&o).contains("truth most likely"), "{}", stdout(&o));
+    let beliefs: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("beliefs.json")).unwrap()).unwrap();
+    assert_eq!(beliefs["format"], "qrm-beliefs");
+    let triples = beliefs["triples"].as_array().unwrap();
+    assert!(!triples.is_empty() && triples.len() <= 56);
+    for t in triples {
+        let p: Vec<f64> = serde_json::from_value(t["ab_c"].clone()).unwrap();
+        assert_eq!(p.len(), 20);
+        assert!((p.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+        assert!(t["a"].as_u64() < t["b"].as_u64() && t["b"].as_u64() < t["c"].as_u64());
+    }
+    let o = pipeline(&[
+        "simulate",
+        "single",
+        "--mode",
+        "probabilistic",
+        "--calculus",
+        "fdc",
+        "--out",
+        dir.path().join("f").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--calculus edc"));
+    assert!(!dir.path().join("f").exists());
 }

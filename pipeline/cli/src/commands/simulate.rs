@@ -12,6 +12,7 @@ use qrm_core::geometry::Point;
 use qrm_core::map::{Hypergraph, Sighting};
 use qrm_core::measurement::MAX_BEARING_UNCERTAINTY;
 use qrm_core::neighborhood::{estimate, true_rng};
+use qrm_core::simulation::beliefs::{beliefs, compare, BeliefSettings, Variant};
 use qrm_core::simulation::{
     run, MonteCarlo, MonteCarloResult, Scenario, Sensor, Series, Statistic,
 };
@@ -133,9 +134,75 @@ pub struct SingleArgs {
     seed: u64,
     #[command(flatten)]
     sensor: SensorArgs,
+    /// `probabilistic`: also 002's beliefs (Mor & Indelman) over the 20 EDC states of every
+    /// triple seen together at two or more imaging points, beside the deterministic map:
+    /// beliefs.json and a comparison of both with the truth (docs/PROBABILISTIC.md). EDC only.
+    #[arg(long, value_enum, default_value = "deterministic")]
+    mode: Mode,
+    #[command(flatten)]
+    beliefs: BeliefArgs,
     /// Output directory.
     #[arg(long, default_value = "simulation")]
     out: PathBuf,
+}
+
+/// What `simulate single` maps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Mode {
+    /// The map of sets (000).
+    Deterministic,
+    /// The map of sets, and 002's beliefs beside it.
+    Probabilistic,
+}
+
+/// How `--mode probabilistic` makes its beliefs.
+#[derive(Args, Debug)]
+pub struct BeliefArgs {
+    /// 002's estimator: `fast` (§III-D) or `full` (Algorithm 1).
+    #[arg(long, value_enum, default_value = "fast")]
+    estimator: Estimator,
+    /// Views per triple: the first imaging points that see it (002: 3 time steps).
+    #[arg(long, default_value_t = 3)]
+    views: usize,
+    /// Noise of 002's motion command (heading of the displacement between two views, which
+    /// the deterministic map does not use), s.d. in degrees.
+    #[arg(long, default_value_t = 2.0)]
+    motion_noise: f64,
+    /// Particles per triple.
+    #[arg(long, default_value_t = 300)]
+    particles: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Estimator {
+    Fast,
+    Full,
+}
+
+impl BeliefArgs {
+    fn settings(&self) -> Result<BeliefSettings> {
+        if self.views < 2 {
+            bail!("--views must be at least 2: 002 resects C from two views or more");
+        }
+        if self.particles == 0 {
+            bail!("--particles must be positive");
+        }
+        if !(0.0..=60.0).contains(&self.motion_noise) {
+            bail!(
+                "--motion-noise {} must lie in [0, 60] degrees",
+                self.motion_noise
+            );
+        }
+        Ok(BeliefSettings {
+            variant: match self.estimator {
+                Estimator::Fast => Variant::Fast,
+                Estimator::Full => Variant::Full,
+            },
+            views: self.views,
+            motion_noise: self.motion_noise.to_radians(),
+            particles: self.particles,
+        })
+    }
 }
 
 #[derive(Args, Debug)]
@@ -151,9 +218,17 @@ pub fn run_command(command: SimulateCommand) -> Result<()> {
         SimulateCommand::Montecarlo(args) => montecarlo(args),
         SimulateCommand::Directions(args) => super::directions::study(&args),
         SimulateCommand::Probabilistic(args) => super::probabilistic::run(&args),
-        SimulateCommand::Single(args) => match args.calculus {
-            CalculusName::Edc => single::<Edc>(&args),
-            CalculusName::Fdc => single::<Fdc>(&args),
+        SimulateCommand::Single(args) => match (args.calculus, args.mode) {
+            (CalculusName::Edc, Mode::Probabilistic) => {
+                let settings = args.beliefs.settings()?;
+                let simulated = single::<Edc>(&args)?;
+                probabilistic_single(&args, &settings, &simulated)
+            }
+            (CalculusName::Fdc, Mode::Probabilistic) => bail!(
+                "--mode probabilistic needs --calculus edc: 002's beliefs are over the 20 EDC states"
+            ),
+            (CalculusName::Edc, Mode::Deterministic) => single::<Edc>(&args).map(drop),
+            (CalculusName::Fdc, Mode::Deterministic) => single::<Fdc>(&args).map(drop),
         },
         SimulateCommand::Basic(args) => match args.calculus {
             CalculusName::Edc => basic::<Edc>(args.seed),
@@ -346,7 +421,14 @@ fn summary(result: &MonteCarloResult, seconds: f64) -> String {
     out
 }
 
-fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
+/// A simulated map with what made it.
+struct Simulated<C: Calculus> {
+    scenario: Scenario,
+    sensor: Sensor,
+    map: Hypergraph<C>,
+}
+
+fn single<C: Calculus>(args: &SingleArgs) -> Result<Simulated<C>> {
     if args.landmarks < 3 || args.stations == 0 {
         bail!("need at least 3 landmarks and 1 imaging point");
     }
@@ -462,6 +544,57 @@ fn single<C: Calculus>(args: &SingleArgs) -> Result<()> {
             ""
         }
     );
+    Ok(Simulated {
+        scenario,
+        sensor,
+        map,
+    })
+}
+
+/// `--mode probabilistic`: 002's beliefs from the panoramas the map was built from, written
+/// to beliefs.json, and both maps compared with the truth.
+fn probabilistic_single(
+    args: &SingleArgs,
+    settings: &BeliefSettings,
+    simulated: &Simulated<Edc>,
+) -> Result<()> {
+    let start = Instant::now();
+    let beliefs = beliefs(&simulated.scenario, &simulated.sensor, args.seed, settings);
+    let c = compare(&beliefs, &simulated.map, &simulated.scenario);
+    let elapsed = start.elapsed().as_secs_f64();
+    write_atomic(
+        &args.out.join("beliefs.json"),
+        beliefs.to_json(settings).as_bytes(),
+    )?;
+    let pct = |n: usize| 100.0 * n as f64 / c.triples.max(1) as f64;
+    println!(
+        "002 beliefs ({} estimator, ≤ {} views, motion noise {}°) for {} triples seen from two or more points, in {elapsed:.2} s:",
+        match settings.variant {
+            Variant::Fast => "fast",
+            Variant::Full => "full",
+        },
+        settings.views,
+        args.beliefs.motion_noise,
+        c.triples
+    );
+    println!(
+        "  truth most likely {:.1}%, truth in the belief's support {:.1}%, median DMSE {:.3}, mean support {:.2} states",
+        pct(c.truth_most_likely),
+        pct(c.truth_in_support),
+        c.median_dmse,
+        c.mean_support_size
+    );
+    println!(
+        "  deterministic map on the same triples: truth in the set {:.1}%, mean set {:.2} states; the belief's most likely state in the set {:.1}%",
+        pct(c.truth_in_set),
+        c.mean_set_size,
+        pct(c.most_likely_in_set)
+    );
+    println!(
+        "  beliefs conditioned on the map (its set, each state floored): truth most likely {:.1}%",
+        pct(c.conditioned_truth_most_likely)
+    );
+    println!("wrote {}/beliefs.json", args.out.display());
     Ok(())
 }
 
