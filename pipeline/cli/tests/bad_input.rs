@@ -1546,6 +1546,11 @@ fn directions_cases() -> Vec<Case> {
             &["--bearing-noise"],
         ),
         Case::new(
+            "simulate probabilistic: noise levels not increasing",
+            "simulate probabilistic --noise-levels 3,1 --out {dir}/p",
+            &["--noise-levels"],
+        ),
+        Case::new(
             "simulate single --mode probabilistic: one view cannot resect",
             "simulate single --mode probabilistic --views 1 --out {dir}/s",
             &["--views"],

@@ -418,10 +418,18 @@ fn probabilistic_table_one() {
         "100",
         "--baseline-samples",
         "200",
+        "--noise-levels",
+        "0.5,2",
         "--out",
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // 002 Fig. 4 at two noise levels.
+    let fig4: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fig4.json")).unwrap()).unwrap();
+    assert_eq!(fig4["levels"].as_array().unwrap().len(), 2);
+    assert_eq!(fig4["levels"][1]["motion_noise_deg"], 4.0);
+    assert!(out.join("fig4.png").is_file() && out.join("fig4.svg").is_file());
     let table: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("table1.json")).unwrap()).unwrap();
     let rows = table["rows"].as_array().unwrap();

@@ -20,12 +20,14 @@ fn panels() -> Vec<Panel> {
             label: format!("n = {n}"),
             mean,
             std,
+            band: None,
         }
     };
     let panel = |title: &str, y_label: &str, f: &dyn Fn(f64, f64) -> (f64, f64)| Panel {
         title: title.into(),
         y_label: y_label.into(),
         curves: sizes.iter().map(|&n| curve(n, f)).collect(),
+        x: Vec::new(),
     };
     vec![
         panel(
@@ -57,8 +59,10 @@ fn panels() -> Vec<Panel> {
                         })
                         .collect(),
                     std: Vec::new(),
+                    band: None,
                 })
                 .collect(),
+            x: Vec::new(),
         },
     ]
 }

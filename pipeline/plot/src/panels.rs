@@ -2,7 +2,8 @@
 //! 2×2 (a–d), each plotting one metric against the number of images incorporated, one curve
 //! per experimental setting (n closest landmarks) with its mean and a ±1 standard deviation
 //! band. Curves with the same label get the same colour in every panel, and one legend below
-//! the panels serves them all, as in the paper.
+//! the panels serves them all, as in the paper. A panel may give its own x values (002 Fig. 4:
+//! noise levels) and a curve its own band (the quartiles around a median).
 
 use super::error::PlotError;
 use super::font::FAMILY;
@@ -28,9 +29,12 @@ pub struct Curve {
     /// Its standard deviation per image (same length as `mean`), or empty to draw the mean
     /// alone (as Fig. 7d does for computation times).
     pub std: Vec<f64>,
+    /// A band from `low` to `high` per point, drawn instead of mean ± std (e.g. the 25th and
+    /// 75th percentiles around a median).
+    pub band: Option<(Vec<f64>, Vec<f64>)>,
 }
 
-/// One panel: x = image number 1..=len, y = the metric.
+/// One panel: x = image number 1..=len (or `x`), y = the metric.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Panel {
     /// Caption above the panel, e.g. `(a) incorrect EDC states removed`.
@@ -39,6 +43,33 @@ pub struct Panel {
     pub y_label: String,
     /// The curves, drawn in order.
     pub curves: Vec<Curve>,
+    /// The x value of each point, increasing, one per value of every curve; empty: the image
+    /// numbers 1, 2, …
+    pub x: Vec<f64>,
+}
+
+impl Panel {
+    /// The x value of point `i`.
+    fn x_at(&self, i: usize) -> f64 {
+        self.x.get(i).copied().unwrap_or(i as f64 + 1.0)
+    }
+}
+
+impl Curve {
+    /// The band's bounds at point `i`: low..high, or mean ± std, or the mean alone.
+    fn bounds(&self, i: usize) -> (f64, f64) {
+        match &self.band {
+            Some((low, high)) => (low[i], high[i]),
+            None => {
+                let std = self.std.get(i).copied().unwrap_or(0.0);
+                (self.mean[i] - std, self.mean[i] + std)
+            }
+        }
+    }
+
+    fn has_band(&self) -> bool {
+        self.band.is_some() || !self.std.is_empty()
+    }
 }
 
 /// The most panels one figure holds (Fig. 7 a–d).
@@ -86,6 +117,23 @@ fn validate(panels: &[Panel]) -> Result<(), String> {
                     curve.std.len()
                 ));
             }
+            if !panel.x.is_empty() && panel.x.len() != curve.mean.len() {
+                return Err(format!(
+                    "{name} has {} values but the panel {} x values",
+                    curve.mean.len(),
+                    panel.x.len()
+                ));
+            }
+            if let Some((low, high)) = &curve.band {
+                if low.len() != curve.mean.len() || high.len() != curve.mean.len() {
+                    return Err(format!(
+                        "{name}: its band is not one low and high per value"
+                    ));
+                }
+                if low.iter().chain(high).any(|v| !v.is_finite()) {
+                    return Err(format!("{name}: its band has a non-finite bound"));
+                }
+            }
             if let Some((i, v)) = curve.mean.iter().enumerate().find(|(_, v)| !v.is_finite()) {
                 return Err(format!("{name}: mean at image {} is {v}", i + 1));
             }
@@ -100,6 +148,11 @@ fn validate(panels: &[Panel]) -> Result<(), String> {
                     i + 1
                 ));
             }
+        }
+        if panel.x.iter().any(|v| !v.is_finite()) || panel.x.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(format!(
+                "{name}: its x values are not finite and increasing"
+            ));
         }
         let range = y_range(panel);
         if !(range.end - range.start).is_finite() {
@@ -167,14 +220,14 @@ impl Figure for Panels<'_> {
     }
 }
 
-/// The y range covering every mean ± std of `panel`, with a margin.
+/// The y range covering every curve and band of `panel`, with a margin.
 fn y_range(panel: &Panel) -> Range<f64> {
     let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
     for curve in &panel.curves {
         for (i, &mean) in curve.mean.iter().enumerate() {
-            let std = curve.std.get(i).copied().unwrap_or(0.0);
-            low = low.min(mean - std);
-            high = high.max(mean + std);
+            let (a, b) = curve.bounds(i);
+            low = low.min(mean).min(a);
+            high = high.max(mean).max(b);
         }
     }
     let span = high - low;
@@ -192,9 +245,15 @@ fn draw_panel<DB: DrawingBackend>(
     panel: &Panel,
     colour: &impl Fn(&str) -> RGBColor,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-    let images = panel.curves.iter().map(|c| c.mean.len()).max().unwrap_or(1) as i32;
-    // A single image still needs an x interval to draw in.
-    let x_range = if images > 1 { 1..images } else { 0..2 };
+    let points = panel.curves.iter().map(|c| c.mean.len()).max().unwrap_or(1);
+    let (first, last) = (panel.x_at(0), panel.x_at(points - 1));
+    // A single point still needs an x interval to draw in.
+    let x_range = if points > 1 {
+        first..last
+    } else {
+        first - 1.0..first + 1.0
+    };
+    let x_ticks = tick_formatter(&x_range);
     let y_range = y_range(panel);
     let y_ticks = tick_formatter(&y_range);
     let mut chart = ChartBuilder::on(area)
@@ -207,6 +266,7 @@ fn draw_panel<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(x_label)
         .y_desc(&panel.y_label)
+        .x_label_formatter(&x_ticks)
         .y_label_formatter(&y_ticks)
         .label_style((FAMILY, 18).into_font())
         .axis_desc_style((FAMILY, 21).into_font())
@@ -215,23 +275,19 @@ fn draw_panel<DB: DrawingBackend>(
         .draw()?;
     for curve in &panel.curves {
         let colour = colour(&curve.label);
-        let points = |sign: f64| {
-            curve
-                .mean
-                .iter()
-                .zip(&curve.std)
-                .enumerate()
-                .map(move |(i, (m, s))| (i as i32 + 1, m + sign * s))
-        };
-        if !curve.std.is_empty() {
-            let band: Vec<(i32, f64)> = points(1.0).chain(points(-1.0).rev()).collect();
+        if curve.has_band() {
+            let n = curve.mean.len();
+            let band: Vec<(f64, f64)> = (0..n)
+                .map(|i| (panel.x_at(i), curve.bounds(i).1))
+                .chain((0..n).rev().map(|i| (panel.x_at(i), curve.bounds(i).0)))
+                .collect();
             chart.draw_series(std::iter::once(Polygon::new(band, colour.mix(0.18))))?;
         }
         let mean = curve
             .mean
             .iter()
             .enumerate()
-            .map(|(i, &m)| (i as i32 + 1, m));
+            .map(|(i, &m)| (panel.x_at(i), m));
         // A one-image curve is a single point, which a line alone would not show.
         let marker = if curve.mean.len() == 1 { 5 } else { 0 };
         chart.draw_series(LineSeries::new(mean, colour.stroke_width(3)).point_size(marker))?;
@@ -251,6 +307,7 @@ mod tests {
             label: label.into(),
             mean,
             std,
+            band: None,
         }
     }
 
@@ -259,6 +316,7 @@ mod tests {
             title: "(a) states removed".into(),
             y_label: "removed [%]".into(),
             curves,
+            x: Vec::new(),
         }
     }
 
@@ -300,6 +358,38 @@ mod tests {
         assert_eq!(png_size(&path), SIZE);
     }
 
+    /// 002 Fig. 4's form: medians over noise levels with their quartiles as bands.
+    #[test]
+    fn x_values_and_quartile_bands_are_drawn_and_checked() {
+        let dir = scratch_dir("panels-x");
+        let path = dir.join("fig4.png");
+        let median = Curve {
+            label: "full".into(),
+            mean: vec![0.0, 0.05, 0.3, 0.7],
+            std: Vec::new(),
+            band: Some((vec![0.0, 0.0, 0.1, 0.2], vec![0.1, 0.5, 0.9, 1.1])),
+        };
+        let mut fig4 = panel(vec![median.clone()]);
+        fig4.x = vec![0.5, 1.0, 3.0, 7.0];
+        write_panels(&path, "bearing noise [deg]", &[fig4.clone()]).unwrap();
+        assert_eq!(png_size(&path), SIZE);
+        let mut decreasing = fig4.clone();
+        decreasing.x = vec![0.5, 1.0, 1.0, 7.0];
+        let mut short = fig4.clone();
+        short.x.pop();
+        let mut bad_band = fig4;
+        bad_band.curves[0].band = Some((vec![0.0; 3], vec![1.0; 4]));
+        for (panel, reason) in [
+            (decreasing, "increasing"),
+            (short, "3 x values"),
+            (bad_band, "band"),
+        ] {
+            let error = write_panels(&dir.join("bad.png"), "x", &[panel]).unwrap_err();
+            assert!(error.to_string().contains(reason), "{error}");
+        }
+        assert_eq!(file_names(&dir), ["fig4.png"]);
+    }
+
     #[test]
     fn bad_extension_is_an_error_naming_the_file() {
         let dir = scratch_dir("panels-extension");
@@ -333,6 +423,7 @@ mod tests {
                     label: "n = 6".into(),
                     mean: vec![1.0],
                     std: vec![f64::INFINITY],
+                    band: None,
                 }])],
                 "standard deviation at image 1 is inf",
             ),

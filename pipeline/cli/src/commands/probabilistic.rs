@@ -6,8 +6,11 @@ use super::output::stage_json;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use qrm_atomic_file::OutputSet;
-use qrm_core::probabilistic::study::{quartiles, run_study, Outcome, Score, StudySettings};
+use qrm_core::probabilistic::study::{
+    quartiles, run_study, Accuracy, Outcome, Score, StudySettings,
+};
 use qrm_core::probabilistic::Noise;
+use qrm_plot::{write_panels, Curve, Panel};
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -32,7 +35,12 @@ pub struct ProbabilisticArgs {
     baseline_samples: usize,
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Output directory: table1.json, outcomes.json.
+    /// Also 002's Fig. 4: the study at each of these bearing-noise levels (degrees) with
+    /// motion noise twice as large, drawn as fig4.png / fig4.svg (medians and quartiles of
+    /// DMSE, gmd, entropy and the cameras' DMSE) with the numbers in fig4.json.
+    #[arg(long, value_delimiter = ',')]
+    noise_levels: Vec<f64>,
+    /// Output directory: table1.json, outcomes.json (and the fig4 files).
     #[arg(long, default_value = "probabilistic")]
     out: PathBuf,
 }
@@ -73,6 +81,11 @@ pub fn run(args: &ProbabilisticArgs) -> Result<()> {
     let within = |value: f64, most: f64| value > 0.0 && value <= most;
     if !(within(args.bearing_noise, 30.0) && within(args.motion_noise, 60.0)) {
         bail!("--bearing-noise must be in (0, 30] and --motion-noise in (0, 60] degrees");
+    }
+    if args.noise_levels.iter().any(|&v| !within(v, 30.0))
+        || args.noise_levels.windows(2).any(|w| w[0] >= w[1])
+    {
+        bail!("--noise-levels must increase, each in (0, 30] degrees");
     }
     let settings = StudySettings {
         scenarios: args.scenarios,
@@ -169,6 +182,9 @@ pub fn run(args: &ProbabilisticArgs) -> Result<()> {
         &args.out.join("outcomes.json"),
         &serde_json::to_value(&outcomes)?,
     )?;
+    if !args.noise_levels.is_empty() {
+        figure_four(&mut outputs, args, &settings)?;
+    }
     outputs
         .commit()
         .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
@@ -177,5 +193,110 @@ pub fn run(args: &ProbabilisticArgs) -> Result<()> {
         args.out.display(),
         started.elapsed().as_secs_f64()
     );
+    Ok(())
+}
+
+/// The four metrics of Fig. 4's panels: DMSE, gmd and entropy of `AB:C`, and the cameras'
+/// DMSE (Eq. 10), each over the scenarios (and cameras) of one algorithm.
+fn metrics(outcomes: &[Outcome], k: usize) -> [Vec<f64>; 4] {
+    let landmark = |f: fn(&Accuracy) -> f64| outcomes.iter().map(move |o| f(&pick(k, o).landmark));
+    [
+        landmark(|a| a.dmse).collect(),
+        landmark(|a| a.gmd).collect(),
+        landmark(|a| a.entropy).collect(),
+        outcomes
+            .iter()
+            .flat_map(|o| pick(k, o).cameras.iter().map(|a| a.dmse))
+            .collect(),
+    ]
+}
+
+/// 002 Fig. 4: the study at every `--noise-levels` σ_v with σ_w = 2σ_v ("motion noise ×2");
+/// stages fig4.png, fig4.svg and fig4.json.
+fn figure_four(
+    outputs: &mut OutputSet,
+    args: &ProbabilisticArgs,
+    base: &StudySettings,
+) -> Result<()> {
+    let bar = super::simulate::progress(
+        (args.scenarios * args.noise_levels.len()) as u64,
+        "Fig. 4 triplets",
+    );
+    // [level][algorithm][metric] → quartiles
+    let mut quartile_table: Vec<[[[f64; 3]; 4]; 3]> = Vec::new();
+    for &level in &args.noise_levels {
+        let settings = StudySettings {
+            noise: Noise {
+                bearing: level.to_radians(),
+                motion: (2.0 * level).to_radians(),
+            },
+            ..*base
+        };
+        let outcomes = run_study(&settings, &|| bar.inc(1));
+        quartile_table.push(std::array::from_fn(|k| {
+            metrics(&outcomes, k).map(|mut values| quartiles(&mut values))
+        }));
+    }
+    bar.finish_and_clear();
+    let titles = [
+        ("(a) DMSE of AB:C", "DMSE"),
+        ("(b) geometric mean distance of AB:C", "gmd [|AB|]"),
+        ("(c) entropy of AB:C", "entropy [nats]"),
+        ("(d) DMSE of the cameras' AB:X (Eq. 10)", "DMSE"),
+    ];
+    let panels: Vec<Panel> = titles
+        .iter()
+        .enumerate()
+        .map(|(m, (title, y_label))| Panel {
+            title: title.to_string(),
+            y_label: y_label.to_string(),
+            x: args.noise_levels.clone(),
+            curves: PAPER
+                .iter()
+                .enumerate()
+                .map(|(k, (name, _, _))| {
+                    let q = |i: usize| quartile_table.iter().map(|l| l[k][m][i]).collect();
+                    Curve {
+                        label: format!("{name}: median, band 25th–75th percentile"),
+                        mean: q(1),
+                        std: Vec::new(),
+                        band: Some((q(0), q(2))),
+                    }
+                })
+                .collect(),
+        })
+        .collect();
+    let x_label = "bearing noise σ_v [degrees]; motion noise 2σ_v";
+    for name in ["fig4.png", "fig4.svg"] {
+        let path = args.out.join(name);
+        outputs.stage(&path, |temporary| write_panels(temporary, x_label, &panels))?;
+    }
+    let levels: Vec<serde_json::Value> = args
+        .noise_levels
+        .iter()
+        .zip(&quartile_table)
+        .map(|(&level, table)| {
+            let algorithm = |k: usize| {
+                json!({"dmse": table[k][0], "gmd": table[k][1], "entropy_nats": table[k][2], "camera_dmse": table[k][3]})
+            };
+            json!({
+                "bearing_noise_deg": level,
+                "motion_noise_deg": 2.0 * level,
+                "baseline": algorithm(0), "full": algorithm(1), "fast": algorithm(2),
+            })
+        })
+        .collect();
+    stage_json(
+        outputs,
+        &args.out.join("fig4.json"),
+        &json!({"format": "qrm-probabilistic-fig4", "version": 1, "scenarios": args.scenarios, "levels": levels}),
+    )?;
+    println!("002 Fig. 4, median DMSE of AB:C (baseline / full / fast) by bearing noise, motion noise twice that:");
+    for (&level, table) in args.noise_levels.iter().zip(&quartile_table) {
+        println!(
+            "  σ_v {level:>4}°: {:.2} / {:.2} / {:.2}",
+            table[0][0][1], table[1][0][1], table[2][0][1]
+        );
+    }
     Ok(())
 }

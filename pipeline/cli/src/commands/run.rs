@@ -560,6 +560,7 @@ fn timing_panels(records: &[StationRecord]) -> Vec<Panel> {
         label: label.to_string(),
         mean: records.iter().map(value).collect(),
         std: Vec::new(),
+        band: None,
     };
     vec![
         Panel {
@@ -572,6 +573,7 @@ fn timing_panels(records: &[StationRecord]) -> Vec<Panel> {
                 curve("associate", &|r| r.seconds.associate),
                 curve("measure and fuse", &|r| r.seconds.map),
             ],
+            x: Vec::new(),
         },
         Panel {
             title: "(b) map size".into(),
@@ -579,6 +581,7 @@ fn timing_panels(records: &[StationRecord]) -> Vec<Panel> {
             curves: vec![curve("landmarks in the map", &|r| {
                 r.metrics.landmarks as f64
             })],
+            x: Vec::new(),
         },
     ]
 }

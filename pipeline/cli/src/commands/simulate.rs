@@ -304,6 +304,7 @@ fn montecarlo_panels(result: &MonteCarloResult) -> Vec<Panel> {
                 } else {
                     Vec::new()
                 },
+                band: None,
             })
             .collect::<Vec<_>>()
     };
@@ -311,6 +312,7 @@ fn montecarlo_panels(result: &MonteCarloResult) -> Vec<Panel> {
         title: title.to_string(),
         y_label: y.to_string(),
         curves,
+        x: Vec::new(),
     };
     let time = panel(
         "(d) time per update",
