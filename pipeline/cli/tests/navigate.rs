@@ -272,12 +272,46 @@ fn drives_through_the_rendered_world_without_seeing_it() {
             out.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        for file in ["trips.json", "summary.json", "drive.png"] {
+        for file in ["trips.json", "summary.json", "drive.png", "drive.mcap"] {
             assert!(out.join(file).is_file(), "{file}");
         }
         let trips: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("trips.json")).unwrap())
                 .unwrap();
+        // The per-step log holds every step of every trip, in order.
+        let log = std::fs::read(out.join("drive.mcap")).unwrap();
+        let messages: Vec<serde_json::Value> = mcap::MessageStream::new(&log)
+            .unwrap()
+            .map(|m| {
+                let m = m.unwrap();
+                assert_eq!(m.channel.topic, "/navigation/step");
+                serde_json::from_slice(&m.data).unwrap()
+            })
+            .collect();
+        let steps: usize = trips
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t["navigator_seconds"].as_array().unwrap().len())
+            .sum();
+        assert_eq!(messages.len(), steps);
+        if let Some(first) = messages.first() {
+            assert_eq!(
+                (first["trip"].as_u64(), first["step"].as_u64()),
+                (Some(0), Some(0))
+            );
+            assert_eq!(first["position"], trips[0]["path"][0]);
+        }
+        // The A* reference: at least the straight distance to the goal's cell can be shorter
+        // than to its rock, never longer than a generous detour.
+        for t in trips.as_array().unwrap() {
+            if let Some(reference) = t["reference_m"].as_f64() {
+                assert!(
+                    reference <= 3.0 * t["straight_m"].as_f64().unwrap() + 1.0,
+                    "{t}"
+                );
+            }
+        }
         trips
             .as_array()
             .unwrap()

@@ -30,6 +30,7 @@
 //! judged against the truth only after the trip: the rover stopped in the goal landmark's
 //! Voronoi cell (the landmark whose rock is nearest to it).
 
+use crate::reference_path::shortest_path_m;
 use crate::render::{render, Eye, Pose};
 use crate::world::World;
 use image::RgbImage;
@@ -106,6 +107,39 @@ pub struct Trip {
     /// Path length, and the straight distance from the start to the goal's rock, metres.
     pub length_m: f64,
     pub straight_m: f64,
+    /// Truth, afterwards: the shortest path from the start into the goal's true cell that
+    /// keeps [`CLEARANCE_M`] from every rock (`reference_path`), metres; `None` when the grid
+    /// has none.
+    pub reference_m: Option<f64>,
+    /// What the navigator saw and decided at every step (the per-step log, drive.mcap).
+    #[serde(skip)]
+    pub steps: Vec<StepLog>,
+}
+
+/// One step of a trip: what the navigator identified and decided, and where the rover truly
+/// stood (the log's, never the navigator's).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StepLog {
+    pub step: usize,
+    /// True position before the step, metres.
+    pub position: [f64; 2],
+    /// Landmarks identified in the panorama.
+    pub identified: Vec<LandmarkId>,
+    /// Detections in the panorama.
+    pub detections: usize,
+    /// The cell the follower believes it is in (the nearest identified landmark).
+    pub cell: Option<LandmarkId>,
+    /// `toward`, `arrived` or `lost`.
+    pub command: &'static str,
+    /// The landmark driven toward, and its bearing in the panorama's frame, degrees.
+    pub target: Option<LandmarkId>,
+    pub bearing_deg: Option<f64>,
+    /// Re-plans so far.
+    pub replans: usize,
+    /// The hazard stop turned or held this step.
+    pub avoided: bool,
+    /// Navigator compute of this step, seconds (detection to heading).
+    pub navigator_seconds: f64,
 }
 
 /// The rendered world the rover drives in.
@@ -146,6 +180,13 @@ impl Terrain<'_> {
         })
     }
 
+    /// The shortest clear path from `start` into `goal`'s true cell (judging only).
+    fn reference(&self, start: Point, goal: LandmarkId) -> Option<f64> {
+        shortest_path_m(self.world, start, CLEARANCE_M, |p| {
+            self.true_cell(p) == Some(goal)
+        })
+    }
+
     /// The map landmark whose rock is nearest to `p`.
     fn true_cell(&self, p: Point) -> Option<LandmarkId> {
         self.landmark_rocks
@@ -177,6 +218,8 @@ pub fn drive(
         avoided: 0,
         navigator_seconds: Vec::new(),
         in_goal_cell: false,
+        reference_m: None,
+        steps: Vec::new(),
         length_m: 0.0,
         straight_m: terrain.landmark_rocks.get(&goal).map_or(f64::NAN, |&r| {
             terrain.world.rocks[r as usize]
@@ -190,7 +233,7 @@ pub fn drive(
     // heading, so a bearing stays good for a few steps while its landmark is not identified.
     let mut last_seen: BTreeMap<LandmarkId, (f64, usize)> = BTreeMap::new();
     let mut approach = 0;
-    for _ in 0..driving.max_steps {
+    for index in 0..driving.max_steps {
         let (left, right) = terrain.panoramas(pose);
         let started = Instant::now();
         let detections = detect_panoramas(
@@ -285,24 +328,45 @@ pub fn drive(
                 };
             }
         }
-        trip.navigator_seconds.push(started.elapsed().as_secs_f64());
-        let bearing = match command {
-            Command::Arrived => {
-                trip.outcome = Outcome::Arrived;
-                break;
-            }
-            Command::Toward { bearing, .. } => bearing,
-            Command::TargetLost(_) => {
-                trip.outcome = Outcome::Lost;
-                break;
-            }
+        let seconds = started.elapsed().as_secs_f64();
+        trip.navigator_seconds.push(seconds);
+        let (name, target, bearing) = match command {
+            Command::Arrived => ("arrived", None, None),
+            Command::Toward { landmark, bearing } => ("toward", Some(landmark), Some(bearing)),
+            Command::TargetLost(landmark) => ("lost", Some(landmark), None),
         };
+        trip.steps.push(StepLog {
+            step: index,
+            position: [pose.position.x, pose.position.y],
+            identified: visible.clone(),
+            detections: detections.primary.len(),
+            cell: here,
+            command: name,
+            target,
+            bearing_deg: bearing.map(f64::to_degrees),
+            replans: trip.replans,
+            avoided: false,
+            navigator_seconds: seconds,
+        });
+        let Some(bearing) = bearing else {
+            trip.outcome = if command == Command::Arrived {
+                Outcome::Arrived
+            } else {
+                Outcome::Lost
+            };
+            break;
+        };
+        let avoided = trip.avoided;
         let next = step(terrain, pose, bearing, driving.step_m, &mut trip);
+        if let Some(log) = trip.steps.last_mut() {
+            log.avoided = trip.avoided > avoided;
+        }
         trip.length_m += pose.position.distance(next);
         pose.position = next;
         trip.path.push([next.x, next.y]);
     }
     trip.in_goal_cell = terrain.true_cell(pose.position) == Some(goal);
+    trip.reference_m = terrain.reference(start.position, goal);
     trip
 }
 

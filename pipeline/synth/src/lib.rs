@@ -15,6 +15,7 @@ pub mod closed_loop;
 pub mod dataset;
 pub mod directions_trial;
 pub mod evaluation;
+pub mod reference_path;
 
 mod capture;
 mod ellipsoid;

@@ -3,6 +3,7 @@
 //! docs/NAVIGATION.md "Closed loop through rendered panoramas").
 
 use super::locate::{load_run, read_landmark_rocks};
+use crate::recording::navigation_log::{self, write_drive_log};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -51,7 +52,7 @@ pub struct DriveArgs {
     lambda: f64,
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Output directory: trips.json, summary.json, drive.png.
+    /// Output directory: trips.json, summary.json, drive.png, drive.mcap (every step).
     #[arg(long, default_value = "drive")]
     out: PathBuf,
 }
@@ -160,6 +161,10 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     outputs.stage(&args.out.join("drive.png"), |temporary| {
         write_flow(temporary, &picture)
     })?;
+    let log = args.out.join("drive.mcap");
+    outputs
+        .stage(&log, |temporary| write_drive_log(temporary, &trips))
+        .with_context(|| format!("cannot write {}", log.display()))?;
     outputs
         .commit()
         .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
@@ -172,10 +177,12 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     );
     println!("{}", serde_json::to_string_pretty(&summary)?);
     println!(
-        "wrote {}, {} and {}",
+        "wrote {}, {}, {} and {} (every step, topic {})",
         args.out.join("trips.json").display(),
         args.out.join("summary.json").display(),
-        args.out.join("drive.png").display()
+        args.out.join("drive.png").display(),
+        args.out.join("drive.mcap").display(),
+        navigation_log::TOPIC
     );
     Ok(())
 }
@@ -246,6 +253,12 @@ fn summarize(trips: &[Trip]) -> serde_json::Value {
         .map(|t| t.length_m / t.straight_m)
         .collect();
     ratios.sort_by(f64::total_cmp);
+    let mut over_reference: Vec<f64> = trips
+        .iter()
+        .filter(|t| t.outcome == Outcome::Arrived && t.in_goal_cell)
+        .filter_map(|t| Some(t.length_m / t.reference_m.filter(|&r| r > 0.0)?))
+        .collect();
+    over_reference.sort_by(f64::total_cmp);
     json!({
         "trips": trips.len(),
         "success": count(&|t| t.outcome == Outcome::Arrived && t.in_goal_cell) as f64 / n,
@@ -256,6 +269,7 @@ fn summarize(trips: &[Trip]) -> serde_json::Value {
         "replans": trips.iter().map(|t| t.replans).sum::<usize>(),
         "steps": trips.iter().map(|t| t.navigator_seconds.len()).sum::<usize>(),
         "median_length_over_straight": quantile(&ratios, 0.5),
+        "median_length_over_reference": quantile(&over_reference, 0.5),
         "navigator_seconds_per_step": {
             "median": quantile(&seconds, 0.5),
             "p90": quantile(&seconds, 0.9),
