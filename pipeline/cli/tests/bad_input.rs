@@ -1432,14 +1432,25 @@ fn argument_cases() -> Vec<Case> {
     ];
     // Only a build without the rerun feature refuses --rrd.
     let without_rerun = cfg!(not(feature = "rerun")).then(|| {
-        Case::new(
-            "--rrd in a build without rerun",
-            "run --images {dir}/img --out {dir}/out --rrd",
-            &["--rrd needs a build with the rerun feature"],
-        )
-        .setup(demo)
+        [
+            Case::new(
+                "--rrd in a build without rerun",
+                "run --images {dir}/img --out {dir}/out --rrd",
+                &["--rrd needs a build with the rerun feature"],
+            )
+            .setup(demo),
+            Case::new(
+                "navigate drive --rrd in a build without rerun",
+                "navigate drive --images {dir}/img --run {dir}/img --out {dir}/out --rrd",
+                &["--rrd needs a build with the rerun feature"],
+            )
+            .setup(demo),
+        ]
     });
-    cases.into_iter().chain(without_rerun).collect()
+    cases
+        .into_iter()
+        .chain(without_rerun.into_iter().flatten())
+        .collect()
 }
 
 #[test]

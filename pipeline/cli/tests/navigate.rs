@@ -346,3 +346,38 @@ fn drives_through_the_rendered_world_without_seeing_it() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("eval.json"));
 }
+
+/// With the `rerun` feature, `navigate drive --rrd` adds `drive.rrd`. With
+/// `QRM_RECORDING_SAMPLES=DIR` it is also copied to `DIR/drive.rrd`, for CI to check with
+/// `rerun rrd verify`.
+#[cfg(feature = "rerun")]
+#[test]
+fn records_a_drive_for_rerun() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let run = demo_run(dir);
+    let out = dir.join("drive");
+    let o = pipeline(&[
+        "navigate",
+        "drive",
+        "--images",
+        DEMO,
+        "--run",
+        run.to_str().unwrap(),
+        "--trips",
+        "1",
+        "--max-steps",
+        "4",
+        "--rrd",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let size = std::fs::metadata(out.join("drive.rrd")).map_or(0, |m| m.len());
+    assert!(size > 0, "drive.rrd missing or empty");
+    if let Some(samples) = std::env::var_os("QRM_RECORDING_SAMPLES") {
+        let samples = std::path::PathBuf::from(samples);
+        std::fs::create_dir_all(&samples).unwrap();
+        std::fs::copy(out.join("drive.rrd"), samples.join("drive.rrd")).unwrap();
+    }
+}

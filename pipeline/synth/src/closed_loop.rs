@@ -121,8 +121,10 @@ pub struct Trip {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StepLog {
     pub step: usize,
-    /// True position before the step, metres.
+    /// True position before the step, metres, and the camera's true heading (the azimuth of
+    /// the panorama's zero bearing), degrees counter-clockwise from +x.
     pub position: [f64; 2],
+    pub heading_deg: f64,
     /// Landmarks identified in the panorama.
     pub identified: Vec<LandmarkId>,
     /// Detections in the panorama.
@@ -338,6 +340,7 @@ pub fn drive(
         trip.steps.push(StepLog {
             step: index,
             position: [pose.position.x, pose.position.y],
+            heading_deg: pose.heading.to_degrees(),
             identified: visible.clone(),
             detections: detections.primary.len(),
             cell: here,

@@ -52,6 +52,9 @@ pub struct DriveArgs {
     lambda: f64,
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Also write OUT/drive.rrd for the rerun viewer (needs a build with `--features rerun`).
+    #[arg(long)]
+    rrd: bool,
     /// Output directory: trips.json, summary.json, drive.png, drive.mcap (every step).
     #[arg(long, default_value = "drive")]
     out: PathBuf,
@@ -66,6 +69,10 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     }
     if !(args.lambda >= 0.0 && args.lambda.is_finite()) {
         bail!("--lambda {} must be a finite number ≥ 0", args.lambda);
+    }
+    #[cfg(not(feature = "rerun"))]
+    if args.rrd {
+        bail!("--rrd needs a build with the rerun feature: cargo build --release -p pipeline --features rerun");
     }
     let (calib, world, origin) = rendered_world(&args.images)?;
     let (known, landmark_rocks) = run_of(&args.run, &world, &args.images)?;
@@ -165,6 +172,28 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     outputs
         .stage(&log, |temporary| write_drive_log(temporary, &trips))
         .with_context(|| format!("cannot write {}", log.display()))?;
+    #[cfg(feature = "rerun")]
+    if args.rrd {
+        use crate::recording::navigation_rerun::{write_drive_rrd, DriveScene};
+        let scene = DriveScene {
+            rocks: world
+                .rocks
+                .iter()
+                .map(|r| ([r.position.x, r.position.y], world.contact_radius(r.id)))
+                .collect(),
+            landmarks: landmark_rocks
+                .iter()
+                .map(|(&l, &r)| {
+                    let p = world.rocks[r as usize].position;
+                    (l, [p.x, p.y])
+                })
+                .collect(),
+        };
+        let rrd = args.out.join("drive.rrd");
+        outputs
+            .stage(&rrd, |temporary| write_drive_rrd(temporary, &scene, &trips))
+            .with_context(|| format!("cannot write {}", rrd.display()))?;
+    }
     outputs
         .commit()
         .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;

@@ -1,13 +1,16 @@
 //! Recordings of a run, station by station: `run.mcap` (JSON messages for Foxglove, the `mcap`
 //! CLI or any MCAP reader) and, with the `rerun` feature, `run.rrd` for the rerun viewer. The
 //! channels and their contents are documented in `docs/RUN_OUTPUTS.md`. Closed-loop drives
-//! log every step to `drive.mcap` (`navigation_log`, docs/NAVIGATION.md).
+//! log every step to `drive.mcap` (`navigation_log`) and, with the feature, `drive.rrd`
+//! (`navigation_rerun`; docs/NAVIGATION.md).
 //!
 //! Both are written through [`qrm_atomic_file::Temporary`]: the target appears only when
 //! [`Recorder::finish`] succeeds, so a crashed run never leaves a truncated recording.
 
 mod mcap_recorder;
 pub mod navigation_log;
+#[cfg(feature = "rerun")]
+pub mod navigation_rerun;
 #[cfg(feature = "rerun")]
 mod rerun_recorder;
 #[cfg(test)]
