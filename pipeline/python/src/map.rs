@@ -7,6 +7,7 @@ use crate::errors::{self, ContradictionError};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
+use qrm_cli::commands::map::constraint_lines;
 use qrm_cli::commands::{rng_json, CalculusName};
 use qrm_core::calculus::{Calculus, RelationSet};
 use qrm_core::edc::Edc;
@@ -104,14 +105,11 @@ fn network<C: Calculus>(text: &str, json: bool) -> anyhow::Result<Network<C>> {
     })
 }
 
-/// The conflict of an inconsistent network, one constraint `A B C {r,…}` per line.
+/// The conflict of an inconsistent network, one constraint `A B C {r,…}` per line, each on a
+/// line of its own after the message.
 fn conflict_lines<C: Calculus>(network: &Network<C>) -> String {
-    network
-        .minimal_conflict()
-        .unwrap_or_default()
-        .iter()
-        .map(|o| format!("\n  {} {} {} {}", o.a, o.b, o.c, o.states))
-        .collect()
+    let conflict = network.minimal_conflict().unwrap_or_default();
+    format!("\n{}", constraint_lines(&conflict).trim_end())
 }
 
 fn close_network<C: Calculus>(py: Python<'_>, text: &str, json: bool) -> PyResult<Hypergraph<C>> {
@@ -133,14 +131,7 @@ fn check_network<C: Calculus>(
 ) -> PyResult<(bool, usize, String)> {
     let network = network::<C>(text, json).map_err(errors::qrm)?;
     Ok(py.detach(|| match network.close() {
-        Ok(map) => {
-            let tightened = network
-                .constraints
-                .iter()
-                .filter(|o| map.relation(o.a, o.b, o.c) != Some(o.states))
-                .count();
-            (true, tightened, String::new())
-        }
+        Ok(map) => (true, network.tightened(&map), String::new()),
         Err(c) => (false, 0, format!("{c}:{}", conflict_lines(&network))),
     }))
 }

@@ -363,7 +363,7 @@ fn network<C: Calculus>(path: &Path) -> Result<Network<C>> {
 }
 
 /// The constraints, one `A B C {r,…}` per line.
-fn constraint_lines(constraints: &[Observation]) -> String {
+pub fn constraint_lines(constraints: &[Observation]) -> String {
     constraints
         .iter()
         .map(|o| format!("  {} {} {} {}\n", o.a, o.b, o.c, o.states))
@@ -402,11 +402,7 @@ fn check<C: Calculus>(file: &Path) -> Result<bool> {
     let network = network::<C>(file)?;
     match network.close() {
         Ok(map) => {
-            let tightened = network
-                .constraints
-                .iter()
-                .filter(|o| map.relation(o.a, o.b, o.c) != Some(o.states))
-                .count();
+            let tightened = network.tightened(&map);
             println!(
                 "{}: consistent as far as path consistency tells ({} network, {} landmarks, {} constraints; closing tightens {} of them)",
                 file.display(),

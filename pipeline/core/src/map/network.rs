@@ -116,6 +116,14 @@ impl<C: Calculus> Network<C> {
         close_all::<C>(&self.landmarks, &self.constraints)
     }
 
+    /// How many constraints `closed` (this network's closed map) holds tighter than given.
+    pub fn tightened(&self, closed: &Hypergraph<C>) -> usize {
+        self.constraints
+            .iter()
+            .filter(|o| closed.relation(o.a, o.b, o.c) != Some(o.states))
+            .count()
+    }
+
     /// A smallest set of constraints that closing finds inconsistent on its own (each one is
     /// needed), or `None` if the network closes. Found by deletion: each constraint is dropped
     /// in turn and kept out while the rest stays inconsistent.
