@@ -140,8 +140,10 @@ pub struct StepLog {
     pub replans: usize,
     /// The hazard stop turned or held this step.
     pub avoided: bool,
-    /// Navigator compute of this step, seconds (detection to heading).
+    /// Navigator compute of this step, seconds (detection to heading), and of it the
+    /// detection in the stereo pair.
     pub navigator_seconds: f64,
+    pub detect_seconds: f64,
 }
 
 /// The rendered world the rover drives in.
@@ -247,6 +249,7 @@ pub fn drive(
             terrain.calib,
             &settings.detector,
         );
+        let detect_seconds = started.elapsed().as_secs_f64();
         let location = known.locate(
             &detections,
             terrain.calib,
@@ -350,6 +353,7 @@ pub fn drive(
             replans: trip.replans,
             avoided: false,
             navigator_seconds: seconds,
+            detect_seconds,
         });
         let Some(bearing) = bearing else {
             trip.outcome = if command == Command::Arrived {

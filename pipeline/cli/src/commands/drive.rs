@@ -269,6 +269,11 @@ fn summarize(trips: &[Trip]) -> serde_json::Value {
         .flat_map(|t| t.navigator_seconds.clone())
         .collect();
     seconds.sort_by(f64::total_cmp);
+    let mut detection: Vec<f64> = trips
+        .iter()
+        .flat_map(|t| t.steps.iter().map(|s| s.detect_seconds))
+        .collect();
+    detection.sort_by(f64::total_cmp);
     let quantile = |v: &[f64], q: f64| {
         if v.is_empty() {
             f64::NAN
@@ -303,6 +308,7 @@ fn summarize(trips: &[Trip]) -> serde_json::Value {
             "median": quantile(&seconds, 0.5),
             "p90": quantile(&seconds, 0.9),
             "max": quantile(&seconds, 1.0),
+            "median_detection": quantile(&detection, 0.5),
         },
     })
 }
