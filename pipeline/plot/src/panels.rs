@@ -247,13 +247,29 @@ fn draw_panel<DB: DrawingBackend>(
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let points = panel.curves.iter().map(|c| c.mean.len()).max().unwrap_or(1);
     let (first, last) = (panel.x_at(0), panel.x_at(points - 1));
-    // A single point still needs an x interval to draw in.
+    // A single point still needs an x interval to draw in (not below 0 for a positive x).
     let x_range = if points > 1 {
         first..last
     } else {
-        first - 1.0..first + 1.0
+        let low = if first >= 0.0 {
+            (first - 1.0).max(0.0)
+        } else {
+            first - 1.0
+        };
+        low..first + 1.0
     };
-    let x_ticks = tick_formatter(&x_range);
+    let real_ticks = tick_formatter(&x_range);
+    // Image numbers are whole: ticks between them stay unlabelled.
+    let image_numbers = panel.x.is_empty();
+    let x_ticks = move |v: &f64| {
+        if !image_numbers {
+            real_ticks(v)
+        } else if (v - v.round()).abs() < 1e-9 {
+            format!("{}", v.round())
+        } else {
+            String::new()
+        }
+    };
     let y_range = y_range(panel);
     let y_ticks = tick_formatter(&y_range);
     let mut chart = ChartBuilder::on(area)

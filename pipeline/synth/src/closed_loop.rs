@@ -131,7 +131,8 @@ pub struct StepLog {
     pub detections: usize,
     /// The cell the follower believes it is in (the nearest identified landmark).
     pub cell: Option<LandmarkId>,
-    /// `toward`, `arrived` or `lost`.
+    /// `toward`, `arrived`, `lost`, or at a first step that cannot start, `start_unknown` or
+    /// `no_route`.
     pub command: &'static str,
     /// The landmark driven toward, and its bearing in the panorama's frame, degrees.
     pub target: Option<LandmarkId>,
@@ -270,20 +271,38 @@ pub fn drive(
             None => None,
         };
         if follower.is_none() {
-            let Some(from) = here else {
-                trip.outcome = Outcome::StartUnknown;
+            let planned = here.map(|from| graph.plan(from, goal, driving.cost));
+            let Some(Ok(route)) = planned else {
+                trip.outcome = if here.is_none() {
+                    Outcome::StartUnknown
+                } else {
+                    Outcome::NoRoute
+                };
+                let seconds = started.elapsed().as_secs_f64();
+                trip.navigator_seconds.push(seconds);
+                trip.steps.push(StepLog {
+                    step: index,
+                    position: [pose.position.x, pose.position.y],
+                    heading_deg: pose.heading.to_degrees(),
+                    identified: visible.clone(),
+                    detections: detections.primary.len(),
+                    cell: here,
+                    command: if here.is_none() {
+                        "start_unknown"
+                    } else {
+                        "no_route"
+                    },
+                    target: None,
+                    bearing_deg: None,
+                    replans: 0,
+                    avoided: false,
+                    navigator_seconds: seconds,
+                    detect_seconds,
+                });
                 break;
             };
-            match graph.plan(from, goal, driving.cost) {
-                Ok(route) => {
-                    trip.route = route.landmarks.clone();
-                    follower = Some(LegFollower::new(&route));
-                }
-                Err(_) => {
-                    trip.outcome = Outcome::NoRoute;
-                    break;
-                }
-            }
+            trip.route = route.landmarks.clone();
+            follower = Some(LegFollower::new(&route));
         }
         let mut command = follower
             .as_mut()

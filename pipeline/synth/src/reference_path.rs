@@ -4,8 +4,9 @@
 //! 8-connected grid over the true world. Judging only: the navigator never sees it.
 //!
 //! An 8-connected grid path is at most `1 / cos(22.5°) − 1 ≈ 8.2 %` longer than the
-//! straight-line path it stands for, and the grid's resolution can close a gap narrower than a
-//! cell; so the reference is an upper bound of the true shortest path to within those.
+//! straight-line path it stands for; clearance is tested at grid points only (a diagonal move
+//! may graze a clearance disc), the start is rounded to the grid, and a gap narrower than a
+//! cell may close. The reference is the true shortest path to within those approximations.
 
 use crate::world::World;
 use pathfinding::directed::dijkstra::dijkstra;

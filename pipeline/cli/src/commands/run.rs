@@ -197,7 +197,8 @@ impl Progress for Bars {
 
     fn advance(&self) {
         if let Some(listener) = &self.listener {
-            // Called under the lock, so that counts reach the listener in order.
+            // Called under the lock, so that counts reach the listener in order: a slow
+            // listener slows the stage's workers, which wait here.
             let mut position = self.position.lock().expect("no panics hold it");
             position.1 += 1;
             listener(position.0, position.1, position.2);

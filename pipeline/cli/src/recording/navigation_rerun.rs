@@ -77,11 +77,10 @@ pub fn write_drive_rrd(path: &Path, scene: &DriveScene, trips: &[Trip]) -> Resul
                         "rover/driving",
                         &rerun::Arrows2D::from_vectors([arrow])
                             .with_origins([at])
-                            .with_labels([format!(
-                                "{} L{}",
-                                step.command,
-                                step.target.unwrap_or(0)
-                            )]),
+                            .with_labels([match step.target {
+                                Some(target) => format!("{} L{target}", step.command),
+                                None => step.command.to_string(),
+                            }]),
                     )
                     .map_err(rerun)?;
             } else {

@@ -308,7 +308,8 @@ pub fn estimate_fast(
 /// bearing ray within `prior` — and the views' beliefs multiplied. A view whose rays all miss
 /// the prior is left out. Each view's histogram is floored at `1e-3` of its mass before the
 /// product, so that one view's empty state does not veto the others (002 does not say). Each
-/// camera's belief is its view's own: poses on the locus, weighted alike.
+/// camera's belief is its view's own: the poses on the locus whose ray meets the prior,
+/// weighted as their `C` samples are (by the ray's length inside the prior).
 pub fn estimate_baseline(
     views: &[View],
     prior: &Prior,

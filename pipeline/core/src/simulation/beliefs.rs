@@ -1,7 +1,8 @@
 //! The probabilistic map of 002 beside the deterministic one, in the simulator: every triple
 //! seen together at some imaging points gets a belief over its 20 EDC states from the first
-//! few of those views (002 Algorithm 1, full or fast), computed from the very panoramas the
-//! deterministic run fused (the same seed draws the same noise).
+//! few of those views (002 Algorithm 1, full or fast), computed from the panoramas the
+//! deterministic run measured (the same seed draws the same noise; `Sensor::observe` is the
+//! only draw of `mapping::run`), those the map rejected included.
 //!
 //! What 002 assumes and the deterministic map does not: a motion command between the views,
 //! the heading of the displacement in the earlier camera's frame, with Gaussian noise. The
@@ -111,7 +112,10 @@ pub fn beliefs(
         .into_par_iter()
         .filter_map(|(ids, stations)| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xbe11ef);
-            rng.set_stream(u64::from(ids[0]) << 42 | u64::from(ids[1]) << 21 | u64::from(ids[2]));
+            let stream = ids.iter().fold(0u64, |h, &id| {
+                h.wrapping_mul(1_000_003).wrapping_add(u64::from(id))
+            });
+            rng.set_stream(stream);
             let views: Vec<View> = stations
                 .iter()
                 .enumerate()
@@ -176,13 +180,13 @@ pub struct BeliefComparison {
     pub conditioned_truth_most_likely: usize,
 }
 
-/// The share every state of the deterministic set keeps in [`conditioned`]: finite particles
-/// can miss a state that sound constraints still allow.
+/// What [`conditioned`] adds to every state of the deterministic set: finite particles can
+/// miss a state that sound constraints still allow.
 pub const FLOOR: f64 = 1e-3;
 
 /// The probabilistic map's belief of a relation: the estimate restricted to the deterministic
-/// map's `set` (sound within the sensor's error model), each state of the set floored at
-/// [`FLOOR`], renormalized. Its support is exactly `set`: the set view of the probabilistic
+/// map's `set` (sound within the sensor's error model), [`FLOOR`] added to each state of the
+/// set, renormalized. Its support is exactly `set`: the set view of the probabilistic
 /// map is the deterministic map, and the belief ranks its states. An empty set (which a
 /// consistent map never holds) gives the estimate unchanged.
 pub fn conditioned(belief: &Belief, set: RelationSet) -> Belief {
@@ -225,8 +229,7 @@ pub fn compare(
     if c.triples > 0 {
         c.mean_set_size = set_sizes as f64 / c.triples as f64;
         c.mean_support_size = support_sizes as f64 / c.triples as f64;
-        dmses.sort_by(f64::total_cmp);
-        c.median_dmse = dmses[dmses.len() / 2];
+        c.median_dmse = crate::probabilistic::study::quartiles(&mut dmses)[1];
     }
     c
 }
