@@ -270,35 +270,35 @@ pub fn drive(
             Some(Cell::Possible(ls)) => ls.first().copied(),
             None => None,
         };
+        // Ends the step's navigator time and logs the step with its decision.
+        let log = |trip: &mut Trip, command, target, bearing: Option<f64>| {
+            let seconds = started.elapsed().as_secs_f64();
+            trip.navigator_seconds.push(seconds);
+            trip.steps.push(StepLog {
+                step: index,
+                position: [pose.position.x, pose.position.y],
+                heading_deg: pose.heading.to_degrees(),
+                identified: visible.clone(),
+                detections: detections.primary.len(),
+                cell: here,
+                command,
+                target,
+                bearing_deg: bearing.map(f64::to_degrees),
+                replans: trip.replans,
+                avoided: false,
+                navigator_seconds: seconds,
+                detect_seconds,
+            });
+        };
         if follower.is_none() {
             let planned = here.map(|from| graph.plan(from, goal, driving.cost));
             let Some(Ok(route)) = planned else {
-                trip.outcome = if here.is_none() {
-                    Outcome::StartUnknown
-                } else {
-                    Outcome::NoRoute
+                let (outcome, command) = match here {
+                    None => (Outcome::StartUnknown, "start_unknown"),
+                    Some(_) => (Outcome::NoRoute, "no_route"),
                 };
-                let seconds = started.elapsed().as_secs_f64();
-                trip.navigator_seconds.push(seconds);
-                trip.steps.push(StepLog {
-                    step: index,
-                    position: [pose.position.x, pose.position.y],
-                    heading_deg: pose.heading.to_degrees(),
-                    identified: visible.clone(),
-                    detections: detections.primary.len(),
-                    cell: here,
-                    command: if here.is_none() {
-                        "start_unknown"
-                    } else {
-                        "no_route"
-                    },
-                    target: None,
-                    bearing_deg: None,
-                    replans: 0,
-                    avoided: false,
-                    navigator_seconds: seconds,
-                    detect_seconds,
-                });
+                trip.outcome = outcome;
+                log(&mut trip, command, None, None);
                 break;
             };
             trip.route = route.landmarks.clone();
@@ -352,28 +352,12 @@ pub fn drive(
                 };
             }
         }
-        let seconds = started.elapsed().as_secs_f64();
-        trip.navigator_seconds.push(seconds);
         let (name, target, bearing) = match command {
             Command::Arrived => ("arrived", None, None),
             Command::Toward { landmark, bearing } => ("toward", Some(landmark), Some(bearing)),
             Command::TargetLost(landmark) => ("lost", Some(landmark), None),
         };
-        trip.steps.push(StepLog {
-            step: index,
-            position: [pose.position.x, pose.position.y],
-            heading_deg: pose.heading.to_degrees(),
-            identified: visible.clone(),
-            detections: detections.primary.len(),
-            cell: here,
-            command: name,
-            target,
-            bearing_deg: bearing.map(f64::to_degrees),
-            replans: trip.replans,
-            avoided: false,
-            navigator_seconds: seconds,
-            detect_seconds,
-        });
+        log(&mut trip, name, target, bearing);
         let Some(bearing) = bearing else {
             trip.outcome = if command == Command::Arrived {
                 Outcome::Arrived

@@ -114,24 +114,8 @@ pub fn run(args: &ProbabilisticArgs) -> Result<()> {
         "", "DMSE", "gmd (|AB| units)", "entropy (nats)", "median time"
     );
     for (k, (name, paper, paper_seconds)) in PAPER.iter().enumerate() {
-        let metric = |m: usize| {
-            let mut v: Vec<f64> = outcomes
-                .iter()
-                .map(|o| pick(k, o).landmark)
-                .map(|a| [a.dmse, a.gmd, a.entropy][m])
-                .collect();
-            quartiles(&mut v)
-        };
-        let ours = [metric(0), metric(1), metric(2)];
-        let camera_metric = |m: usize| {
-            let mut v: Vec<f64> = outcomes
-                .iter()
-                .flat_map(|o| &pick(k, o).cameras)
-                .map(|a| [a.dmse, a.gmd, a.entropy][m])
-                .collect();
-            quartiles(&mut v)
-        };
-        cameras.push((name, [camera_metric(0), camera_metric(1), camera_metric(2)]));
+        let [ours, camera] = accuracy_quartiles(&outcomes, k);
+        cameras.push((name, camera));
         let mut seconds: Vec<f64> = outcomes.iter().map(|o| pick(k, o).seconds).collect();
         let median_seconds = quartiles(&mut seconds)[1];
         let failed = outcomes.iter().filter(|o| pick(k, o).failed).count();
@@ -196,18 +180,21 @@ pub fn run(args: &ProbabilisticArgs) -> Result<()> {
     Ok(())
 }
 
-/// The four metrics of Fig. 4's panels: DMSE, gmd and entropy of `AB:C`, and the cameras'
-/// DMSE (Eq. 10), each over the scenarios (and cameras) of one algorithm.
-fn metrics(outcomes: &[Outcome], k: usize) -> [Vec<f64>; 4] {
-    let landmark = |f: fn(&Accuracy) -> f64| outcomes.iter().map(move |o| f(&pick(k, o).landmark));
+/// The 25th, 50th and 75th percentiles of DMSE, gmd and entropy of algorithm `k`: for
+/// `AB:C` over the scenarios, and for the cameras' `AB:X` (Eq. 10) over every camera.
+fn accuracy_quartiles(outcomes: &[Outcome], k: usize) -> [[[f64; 3]; 3]; 2] {
+    let quartiles_of = |accuracies: Vec<&Accuracy>| {
+        std::array::from_fn(|m| {
+            let mut values: Vec<f64> = accuracies
+                .iter()
+                .map(|a| [a.dmse, a.gmd, a.entropy][m])
+                .collect();
+            quartiles(&mut values)
+        })
+    };
     [
-        landmark(|a| a.dmse).collect(),
-        landmark(|a| a.gmd).collect(),
-        landmark(|a| a.entropy).collect(),
-        outcomes
-            .iter()
-            .flat_map(|o| pick(k, o).cameras.iter().map(|a| a.dmse))
-            .collect(),
+        quartiles_of(outcomes.iter().map(|o| &pick(k, o).landmark).collect()),
+        quartiles_of(outcomes.iter().flat_map(|o| &pick(k, o).cameras).collect()),
     ]
 }
 
@@ -233,8 +220,10 @@ fn figure_four(
             ..*base
         };
         let outcomes = run_study(&settings, &|| bar.inc(1));
+        // Fig. 4's panels: DMSE, gmd and entropy of AB:C, and the cameras' DMSE.
         quartile_table.push(std::array::from_fn(|k| {
-            metrics(&outcomes, k).map(|mut values| quartiles(&mut values))
+            let [landmark, camera] = accuracy_quartiles(&outcomes, k);
+            [landmark[0], landmark[1], landmark[2], camera[0]]
         }));
     }
     bar.finish_and_clear();
