@@ -1,7 +1,7 @@
 //! Scoring association: each landmark stands for the rock most of its sightings show.
 
 use super::detection::ratio;
-use super::AssociationScore;
+use super::{AssociationScore, MixedLandmark};
 use qrm_core::map::LandmarkId;
 use qrm_vision::run::LandmarkRecord;
 use std::collections::{BTreeMap, HashMap};
@@ -42,21 +42,25 @@ pub(super) fn score(
         ..AssociationScore::default()
     };
     for landmark in landmarks {
-        let mut votes: HashMap<u32, usize> = HashMap::new();
+        let mut stations: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
         for s in &landmark.sightings {
             a.sightings += 1;
             match matched.get(s) {
-                Some(&id) => *votes.entry(id).or_default() += 1,
+                Some(&id) => stations.entry(id).or_default().push(s.0),
                 None => a.unmatched_sightings += 1,
             }
         }
-        if votes.len() > 1 {
+        let mut by_rock: Vec<(u32, Vec<usize>)> = stations.into_iter().collect();
+        by_rock.sort_by_key(|(id, seen)| (std::cmp::Reverse(seen.len()), *id));
+        if by_rock.len() > 1 {
             a.mixed_landmarks += 1;
+            a.mixed.push(MixedLandmark {
+                landmark: landmark.landmark,
+                rocks: by_rock.clone(),
+            });
         }
-        if let Some((&id, &count)) = votes
-            .iter()
-            .max_by_key(|(id, c)| (**c, std::cmp::Reverse(**id)))
-        {
+        if let Some((id, seen)) = by_rock.first() {
+            let (id, count) = (*id, seen.len());
             a.correct_sightings += count;
             rocks.majority.insert(landmark.landmark, id);
             *rocks.landmarks_of_rock.entry(id).or_default() += 1;
@@ -65,4 +69,59 @@ pub(super) fn score(
     a.duplicated_rocks = rocks.landmarks_of_rock.values().filter(|&&n| n > 1).count();
     a.accuracy = ratio(a.correct_sightings, a.sightings);
     (a, rocks)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use qrm_vision::association::Profile;
+    use qrm_vision::detection::Appearance;
+
+    fn landmark(landmark: LandmarkId, sightings: &[(usize, usize)]) -> LandmarkRecord {
+        LandmarkRecord {
+            landmark,
+            sightings: sightings.to_vec(),
+            profile: Profile {
+                landmark,
+                appearance: Appearance {
+                    colour: [0.4, 0.33, 0.27],
+                    brightness: 1.0,
+                    texture: 0.2,
+                    dark_fraction: 0.1,
+                },
+                width: None,
+                sightings: sightings.len() as u32,
+            },
+        }
+    }
+
+    #[test]
+    fn a_mixed_landmark_lists_the_stations_of_each_rock_majority_first() {
+        // Landmark 0 is rock 7 at stations 0–2 and rock 9 at station 5; landmark 1 is rock 8.
+        let matched: HashMap<(usize, usize), u32> = [
+            ((0, 0), 7),
+            ((1, 0), 7),
+            ((2, 1), 7),
+            ((5, 3), 9),
+            ((0, 1), 8),
+            ((1, 1), 8),
+        ]
+        .into_iter()
+        .collect();
+        let landmarks = [
+            landmark(0, &[(0, 0), (1, 0), (5, 3), (2, 1)]),
+            landmark(1, &[(0, 1), (1, 1), (4, 2)]),
+        ];
+        let (score, rocks) = score(&landmarks, &matched);
+        assert_eq!(score.mixed_landmarks, 1);
+        assert_eq!(
+            score.mixed,
+            vec![MixedLandmark {
+                landmark: 0,
+                rocks: vec![(7, vec![0, 1, 2]), (9, vec![5])],
+            }]
+        );
+        assert_eq!((score.correct_sightings, score.unmatched_sightings), (5, 1));
+        assert_eq!((rocks.majority(0), rocks.majority(1)), (Some(7), Some(8)));
+    }
 }

@@ -98,6 +98,18 @@ pub struct AssociationScore {
     pub mixed_landmarks: usize,
     /// Sightings of things that are not truth rocks (false detections).
     pub unmatched_sightings: usize,
+    /// Every mixed landmark with the stations that saw each of its rocks: where association
+    /// went wrong.
+    pub mixed: Vec<MixedLandmark>,
+}
+
+/// A landmark whose sightings show more than one rock.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct MixedLandmark {
+    pub landmark: LandmarkId,
+    /// Each rock it was fused from, with the stations (indices into `stations.json`) whose
+    /// sightings show it, most sighted rock first.
+    pub rocks: Vec<(u32, Vec<usize>)>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
