@@ -66,8 +66,10 @@ const MARGIN: f64 = 1.5;
 /// (marsyard seed 5: a rock 15.8 m away, placed within 6 m, paired at five stations with a
 /// landmark 2.7 m from it, 2 unsound relations).
 const ANCHOR_RADIUS_M: f64 = 2.0;
+/// Bearing tolerance, beyond a landmark's placement, within which a detection may be it.
+const UNSEEN_WINDOW_RAD: f64 = 0.05;
 /// Fewest correspondences a registration must explain to be believed.
-const MIN_INLIERS: usize = 4;
+pub(super) const MIN_INLIERS: usize = 4;
 /// Most false alarms expected of a registration accepted on the significance of its fit …
 const SIGNIFICANT_NFA: f64 = 0.01;
 /// … while every rival assignment's fit is no better than this many false alarms: what chance
@@ -322,10 +324,6 @@ impl Registration {
         elsewhere: &[f64],
     ) {
         let direction = |p: [f64; 2]| p[1].atan2(p[0]);
-        let apart = |a: f64, b: f64| {
-            let d = (a - b).rem_euclid(std::f64::consts::TAU);
-            d.min(std::f64::consts::TAU - d)
-        };
         let motion = self.motion();
         self.pairs.retain(|&(i, l)| {
             let (Some(p), Some((_, q))) = (placed[i], frame.landmarks.iter().find(|m| m.0 == l))
@@ -333,9 +331,31 @@ impl Registration {
                 return true;
             };
             let back = direction(motion.unapply(q.point));
-            let own = apart(back, direction(p.point));
-            elsewhere.iter().all(|&b| apart(back, b) >= own)
+            let own = angle_apart(back, direction(p.point));
+            elsewhere.iter().all(|&b| angle_apart(back, b) >= own)
         });
+    }
+
+    /// The frame's unpaired landmarks that the motion brings within `reach` metres of the
+    /// current station in a direction where the station detected nothing (`bearings`, radians,
+    /// of every detection): rocks the motion says are in view and the panorama does not show.
+    pub fn unseen(&self, frame: &Frame, bearings: &[f64], reach: f64) -> usize {
+        let motion = self.motion();
+        frame
+            .landmarks
+            .iter()
+            .filter(|(l, _)| !self.pairs.iter().any(|p| p.1 == *l))
+            .filter(|(_, q)| {
+                let back = motion.unapply(q.point);
+                let range = back[0].hypot(back[1]);
+                if range > reach || range <= q.radius {
+                    return false;
+                }
+                let direction = back[1].atan2(back[0]);
+                let window = (q.radius + SLACK_M).atan2(range) + UNSEEN_WINDOW_RAD;
+                bearings.iter().all(|&b| angle_apart(direction, b) > window)
+            })
+            .count()
     }
 
     /// Where the current station's point `p` lies in the frame's coordinates.
@@ -351,6 +371,12 @@ impl Registration {
             shift: [x, y],
         }
     }
+}
+
+/// Absolute difference of two directions, radians in `[0, π]`.
+fn angle_apart(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(std::f64::consts::TAU);
+    d.min(std::f64::consts::TAU - d)
 }
 
 /// Whether two correspondence sets mostly agree (the same motion found twice).
@@ -487,6 +513,38 @@ pub(super) mod tests {
         [8.0, 8.0],
         [-6.0, -3.0],
     ];
+
+    /// FIELD's six rocks as a frame, landmarks 0‥5.
+    fn field_frame() -> Frame {
+        Frame {
+            accumulated: false,
+            landmarks: FIELD
+                .iter()
+                .enumerate()
+                .map(|(k, &point)| (k as LandmarkId, Placed { point, radius: 0.3 }))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn unseen_counts_unpaired_landmarks_in_view_where_nothing_was_detected() {
+        let frame = field_frame();
+        // Identity motion pairing rocks 0‥2; the station detected rocks 0‥3 and nothing else.
+        let registration = Registration {
+            pairs: vec![(0, 0), (1, 1), (2, 2)],
+            motion: [1.0, 0.0, 0.0, 0.0],
+        };
+        let bearing = |p: [f64; 2]| p[1].atan2(p[0]);
+        let detected: Vec<f64> = FIELD[..4].iter().map(|&p| bearing(p)).collect();
+        // Rock 3 was detected (unpaired, but seen); rocks 4 (11.3 m) and 5 (6.7 m) were not.
+        assert_eq!(registration.unseen(&frame, &detected, 20.0), 2);
+        // Beyond the station's reach an absence says nothing.
+        assert_eq!(registration.unseen(&frame, &detected, 10.0), 1);
+        assert_eq!(registration.unseen(&frame, &detected, 5.0), 0);
+        // A detection within a few degrees of rock 5's direction may be it.
+        let near_five = [detected.clone(), vec![bearing(FIELD[5]) + 0.04]].concat();
+        assert_eq!(registration.unseen(&frame, &near_five, 20.0), 1);
+    }
 
     #[test]
     fn recovers_who_is_who_after_a_rigid_motion() {
