@@ -48,6 +48,12 @@ impl Bearing {
     }
 }
 
+/// How far apart two directions are, radians in `[0, π]` (whichever way round is shorter).
+pub fn angular_distance(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(std::f64::consts::TAU);
+    d.min(std::f64::consts::TAU - d)
+}
+
 /// What one station sees of the landmarks in its panorama: bearings (000 §IV assumption 1) and
 /// the range ordering (assumption 2), indexed by position in `bearings`. Not the image: the
 /// vision crate turns images into views.
@@ -168,4 +174,18 @@ fn edc_candidates<C: Calculus>(open: RelationSet) -> RelationSet {
             .intersection(open)
             .is_empty()
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::angular_distance;
+    use std::f64::consts::{PI, TAU};
+
+    #[test]
+    fn angular_distance_takes_the_shorter_way_round() {
+        assert!((angular_distance(0.1, TAU - 0.1) - 0.2).abs() < 1e-12);
+        assert!((angular_distance(TAU - 0.1, 0.1) - 0.2).abs() < 1e-12);
+        assert!((angular_distance(-3.0 * PI, 0.0) - PI).abs() < 1e-12);
+        assert_eq!(angular_distance(1.0, 1.0 + TAU), 0.0);
+    }
 }

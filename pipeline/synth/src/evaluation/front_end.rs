@@ -4,6 +4,7 @@
 use super::detection::{ratio, Detectable, DetectedBox, Score};
 use super::{BearingScore, CueScore, DetectionScore, RangeScore};
 use crate::dataset::{ImageTruth, Truth};
+use qrm_core::measurement::angular_distance;
 use qrm_vision::calib::Calibration;
 use qrm_vision::run::{Association, DetectionRecord, RangeRecord, StationRecord};
 use std::collections::HashMap;
@@ -65,7 +66,7 @@ impl Tally {
     }
 
     fn add_bearing(&mut self, d: &DetectionRecord, truth: f64) {
-        let error = angle_error(d.bearing, truth);
+        let error = angular_distance(d.bearing, truth);
         self.bearing_errors.push(error);
         if !matches!(d.association, Association::Unused { .. }) {
             self.used_errors.push((error, d.bearing_uncertainty));
@@ -178,11 +179,6 @@ impl Tally {
         };
         (detection, all, used, range)
     }
-}
-
-fn angle_error(a: f64, b: f64) -> f64 {
-    let d = (a - b).rem_euclid(TAU);
-    d.min(TAU - d)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

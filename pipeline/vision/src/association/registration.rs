@@ -10,6 +10,7 @@
 
 use super::significance::Chance;
 use qrm_core::map::LandmarkId;
+use qrm_core::measurement::angular_distance;
 
 /// A point around a station, radius `radius` (metres) of uncertainty.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -331,8 +332,8 @@ impl Registration {
                 return true;
             };
             let back = direction(motion.unapply(q.point));
-            let own = angle_apart(back, direction(p.point));
-            elsewhere.iter().all(|&b| angle_apart(back, b) >= own)
+            let own = angular_distance(back, direction(p.point));
+            elsewhere.iter().all(|&b| angular_distance(back, b) >= own)
         });
     }
 
@@ -353,7 +354,9 @@ impl Registration {
                 }
                 let direction = back[1].atan2(back[0]);
                 let window = (q.radius + SLACK_M).atan2(range) + UNSEEN_WINDOW_RAD;
-                bearings.iter().all(|&b| angle_apart(direction, b) > window)
+                bearings
+                    .iter()
+                    .all(|&b| angular_distance(direction, b) > window)
             })
             .count()
     }
@@ -371,12 +374,6 @@ impl Registration {
             shift: [x, y],
         }
     }
-}
-
-/// Absolute difference of two directions, radians in `[0, π]`.
-fn angle_apart(a: f64, b: f64) -> f64 {
-    let d = (a - b).rem_euclid(std::f64::consts::TAU);
-    d.min(std::f64::consts::TAU - d)
 }
 
 /// Whether two correspondence sets mostly agree (the same motion found twice).
