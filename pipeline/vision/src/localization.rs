@@ -134,7 +134,15 @@ impl<C: Calculus> KnownMap<C> {
         let mut ambiguous = Vec::new();
         if !usable.is_empty() {
             let evidence = station_evidence(station, &ranged, &usable, sensor);
-            let decisions = associate(&self.map, &self.gallery, &self.frames, &evidence, settings);
+            // A finished map has no drive behind it: every landmark may be in view.
+            let decisions = associate(
+                &self.map,
+                &self.gallery,
+                &self.frames,
+                &evidence,
+                settings,
+                &|_| true,
+            );
             for (&i, decision) in usable.iter().zip(decisions) {
                 match decision {
                     Decision::Matched(landmark) => identified.push((i, landmark)),

@@ -8,13 +8,15 @@
 //!    [`Sketch`] of all recently seen landmarks ([`register`]);
 //!    the motion also rules out the frame's landmarks that lie away from a detection. A
 //!    registration of the fewest pairs that puts several of the frame's other landmarks in
-//!    view where the station saw nothing is a chance fit and is dropped. A
+//!    view where the station saw nothing is a chance fit and is dropped, and so is one that
+//!    holds no landmark the rover saw lately ([`LastSeen`]: a loop closure on looks alone). A
 //!    detection placed looser than 2 m pairs with nothing, and a pair whose landmark lies in
 //!    the direction of a detection mapping does not use is dropped (it may be that rock). An
 //!    anchor must be paired so by most registered frames that hold its landmark, and anchors
 //!    are checked against each other: a triple of anchors whose measured states do not
 //!    overlap the map's is inconsistent, and the anchor in most such triples is dropped until
-//!    none is left;
+//!    none is left. Matches are then checked against earlier stations' placements of their
+//!    landmarks ([`agreement`], applied by the caller, which keeps the stations' history);
 //! 3. every other proposal is tested as 000 §VI-C describes: the detection's triples with
 //!    pairs of anchors are measured and compared with the candidate landmark's relations in
 //!    the map; a candidate with an empty overlap in any relation is rejected;
@@ -32,12 +34,15 @@
 //! matched by elimination of the other candidates), against 30 of about 2300 for registration
 //! anchors; the wrong ones made 8 of those 12 maps unsound.
 
+pub mod agreement;
 mod gallery;
+mod recency;
 mod registration;
 mod significance;
 pub mod sketch;
 
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
+pub use recency::LastSeen;
 use registration::MIN_INLIERS;
 pub use registration::{register, Frame, Placed, Registration};
 pub use sketch::Sketch;
@@ -142,13 +147,15 @@ pub enum Decision {
 }
 
 /// Associates the detections of one station with the landmarks of `map` and `gallery`;
-/// `frames` are recent stations' landmarks placed around them.
+/// `frames` are recent stations' landmarks placed around them, and `lately` tells the
+/// landmarks the rover saw lately ([`LastSeen`]) from those it lost sight of.
 pub fn associate<C: Calculus>(
     map: &Hypergraph<C>,
     gallery: &Gallery,
     frames: &[Frame],
     station: &StationEvidence,
     settings: &AssociationSettings,
+    lately: &(dyn Fn(LandmarkId) -> bool + Sync),
 ) -> Vec<Decision> {
     let (view, evidence) = (&station.view, &station.detections);
     let placed: Vec<Option<Placed>> = evidence.iter().map(|e| e.placed).collect();
@@ -167,7 +174,7 @@ pub fn associate<C: Calculus>(
         .map(|b| b.angle)
         .chain(station.unused_bearings.iter().copied())
         .collect();
-    let mut registrations = registrations(frames, &placed, &candidates, &bearings);
+    let mut registrations = registrations(frames, &placed, &candidates, &bearings, lately);
     let elsewhere: Vec<f64> = (0..n)
         .filter(|&k| placed[k].is_none())
         .map(|k| view.bearings[k].angle)
@@ -250,6 +257,7 @@ fn registrations<'f>(
     placed: &[Option<Placed>],
     candidates: &[Vec<(LandmarkId, f64)>],
     bearings: &[f64],
+    lately: &dyn Fn(LandmarkId) -> bool,
 ) -> Vec<(&'f Frame, Registration)> {
     let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
     // Registration hypotheses grow with the square of the seeds: each detection seeds only
@@ -274,6 +282,8 @@ fn registrations<'f>(
             registration.pairs.len() > MIN_INLIERS
                 || registration.unseen(frame, bearings, reach) < MIN_UNSEEN
         })
+        // A registration must hold a landmark the rover saw lately: see `recency`.
+        .filter(|(_, registration)| registration.pairs.iter().any(|p| lately(p.1)))
         .collect();
     // A station's only registration is a chance fit of look-alikes when several other frames
     // hold enough of its landmarks to have found the same pairing and none did.
@@ -624,10 +634,17 @@ mod tests {
         )
     }
 
-    /// Associates the station against `frames` on an empty map with default settings.
-    fn associate_station(
+    /// Associates the station against `frames` on an empty map with default settings, every
+    /// landmark seen lately.
+    fn associate_station(station: &(Gallery, StationEvidence), frames: &[Frame]) -> Vec<Decision> {
+        associate_after(station, frames, &|_| true)
+    }
+
+    /// As [`associate_station`], with the landmarks seen lately given by `lately`.
+    fn associate_after(
         (gallery, station): &(Gallery, StationEvidence),
         frames: &[Frame],
+        lately: &(dyn Fn(LandmarkId) -> bool + Sync),
     ) -> Vec<Decision> {
         associate(
             &Hypergraph::<Edc>::new(),
@@ -635,6 +652,7 @@ mod tests {
             frames,
             station,
             &AssociationSettings::default(),
+            lately,
         )
     }
 
@@ -704,6 +722,20 @@ mod tests {
         let seen = [FIELD[0], FIELD[1], FIELD[2], FIELD[3], FIELD[4]];
         let decisions = associate_station(&station(&seen), &[frame(&FIELD)]);
         assert_eq!(decisions, (0..5).map(Decision::Matched).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn a_registration_without_a_landmark_seen_lately_anchors_nothing() {
+        // The rover lost sight of every landmark of the frame: six look-alikes are a loop
+        // closure on looks alone. With one of them seen lately, the same fit anchors all six.
+        let station = station(&FIELD);
+        let decisions = associate_after(&station, &[frame(&FIELD)], &|_| false);
+        assert!(
+            decisions.iter().all(|d| !matches!(d, Decision::Matched(_))),
+            "{decisions:?}"
+        );
+        let decisions = associate_after(&station, &[frame(&FIELD)], &|l| l == 3);
+        assert_eq!(decisions, (0..6).map(Decision::Matched).collect::<Vec<_>>());
     }
 
     #[test]

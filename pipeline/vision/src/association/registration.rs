@@ -376,6 +376,12 @@ impl Registration {
     }
 }
 
+/// How far `motion` leaves `p` beyond the placement radii of `p` and `q` and the slack,
+/// metres: positive when the two placements cannot be one rock under that motion.
+pub(super) fn misfit(motion: &Motion, p: Placed, q: Placed) -> f64 {
+    distance(motion.apply(p.point), q.point) - (p.radius + q.radius + SLACK_M)
+}
+
 /// Whether two correspondence sets mostly agree (the same motion found twice).
 fn same_assignment(a: &[(usize, usize)], b: &[(usize, usize)]) -> bool {
     let shared = a.iter().filter(|p| b.contains(p)).count();
@@ -439,6 +445,72 @@ impl Motion {
             sin,
             shift: [mq[0] - rotated[0], mq[1] - rotated[1]],
         }
+    }
+
+    /// The least-squares motion taking each `.0` onto its `.1`, fitted on the pairs that agree
+    /// with it: the pair left farthest beyond its placements' radii (plus the slack) is
+    /// dropped and the fit repeated, until every pair fits; none when fewer than `fewest`
+    /// pairs are left.
+    pub(super) fn consensus(mut pairs: Vec<(Placed, Placed)>, fewest: usize) -> Option<Motion> {
+        loop {
+            if pairs.len() < fewest {
+                return None;
+            }
+            let motion = Motion::fit(
+                &pairs
+                    .iter()
+                    .map(|(p, q)| (p.point, q.point))
+                    .collect::<Vec<_>>(),
+            );
+            let excess = |(p, q): &(Placed, Placed)| misfit(&motion, *p, *q);
+            let worst = (0..pairs.len())
+                .max_by(|&a, &b| excess(&pairs[a]).total_cmp(&excess(&pairs[b])))?;
+            if excess(&pairs[worst]) <= 0.0 {
+                return Some(motion);
+            }
+            pairs.swap_remove(worst);
+        }
+    }
+
+    /// The motion most of `pairs` agree on (each `.0` within placement tolerance of its `.1`,
+    /// [`misfit`]), and which pairs agree: every motion taking one pair onto its partner and
+    /// the direction to a second pair onto its partner's is tried, and the one most pairs
+    /// agree with is refitted on those pairs by least squares. Unlike [`Motion::consensus`]
+    /// a pair that is off does not pull the fit: it never takes part in it. None when fewer
+    /// than `fewest` pairs agree.
+    pub(super) fn agreed(pairs: &[(Placed, Placed)], fewest: usize) -> Option<(Motion, Vec<bool>)> {
+        let agreeing = |motion: &Motion| -> Vec<bool> {
+            pairs
+                .iter()
+                .map(|&(p, q)| misfit(motion, p, q) <= 0.0)
+                .collect()
+        };
+        let count = |agree: &[bool]| agree.iter().filter(|&&a| a).count();
+        let best = (0..pairs.len())
+            .flat_map(|a| {
+                (0..pairs.len())
+                    .filter(move |&b| b != a)
+                    .map(move |b| (a, b))
+            })
+            .map(|(a, b)| {
+                agreeing(&Motion::from_pairs(
+                    [pairs[a].0.point, pairs[b].0.point],
+                    [pairs[a].1.point, pairs[b].1.point],
+                ))
+            })
+            .max_by_key(|agree| count(agree))?;
+        if count(&best) < fewest {
+            return None;
+        }
+        let fitted: Vec<PointPair> = pairs
+            .iter()
+            .zip(&best)
+            .filter(|(_, &a)| a)
+            .map(|((p, q), _)| (p.point, q.point))
+            .collect();
+        let motion = Motion::fit(&fitted);
+        let agree = agreeing(&motion);
+        (count(&agree) >= fewest).then_some((motion, agree))
     }
 
     pub(super) fn apply(&self, p: [f64; 2]) -> [f64; 2] {

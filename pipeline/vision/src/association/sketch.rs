@@ -28,7 +28,7 @@ const DECAY: f64 = 0.7;
 /// interval's middle is not the rock's centre.
 const MIN_RADIUS_M: f64 = 0.25;
 
-/// Slack of the outlier test of a station's move into the sketch, metres.
+/// Slack of the test of a placement against its landmark's estimate, metres.
 const SLACK_M: f64 = 0.3;
 
 /// Fewest shared landmarks that fix a station's motion into the sketch.
@@ -97,35 +97,16 @@ impl Sketch {
     }
 
     /// The motion of the station's sightings into the sketch, fitted on the shared landmarks
-    /// that agree with it (the fit is repeated without the pairs it leaves farthest out).
+    /// that agree with it ([`Motion::consensus`]).
     fn motion(&self, sightings: &[(LandmarkId, Placed)]) -> Option<Motion> {
-        let mut pairs: Vec<(Placed, Placed)> = sightings
+        let pairs: Vec<(Placed, Placed)> = sightings
             .iter()
             .filter_map(|(l, p)| {
                 let s = self.landmarks.iter().find(|s| s.landmark == *l)?;
                 Some((*p, s.placed))
             })
             .collect();
-        loop {
-            if pairs.len() < MIN_SHARED {
-                return None;
-            }
-            let motion = Motion::fit(
-                &pairs
-                    .iter()
-                    .map(|(p, q)| (p.point, q.point))
-                    .collect::<Vec<_>>(),
-            );
-            let excess = |(p, q): &(Placed, Placed)| {
-                distance(motion.apply(p.point), q.point) - (p.radius + q.radius + SLACK_M)
-            };
-            let worst = (0..pairs.len())
-                .max_by(|&a, &b| excess(&pairs[a]).total_cmp(&excess(&pairs[b])))?;
-            if excess(&pairs[worst]) <= 0.0 {
-                return Some(motion);
-            }
-            pairs.swap_remove(worst);
-        }
+        Motion::consensus(pairs, MIN_SHARED)
     }
 
     /// Averages a new placement into a landmark's estimate (inverse-variance, the old

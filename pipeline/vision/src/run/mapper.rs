@@ -5,7 +5,8 @@
 use super::record::{Association, DetectionRecord, MetricsRecord, RangeRecord, StationRecord};
 use super::selection;
 use crate::association::{
-    associate, reconsider, sketch, AssociationSettings, Decision, Evidence, Frame, Gallery, Sketch,
+    agreement, associate, reconsider, sketch, AssociationSettings, Decision, Evidence, Frame,
+    Gallery, LastSeen, Placed, Sketch,
 };
 use crate::calib::Calibration;
 use crate::detection::{Detection, Separation};
@@ -63,11 +64,13 @@ pub struct Mapper<C: Calculus> {
     sensor: SensorModel,
     association: AssociationSettings,
     held: Vec<HeldBack>,
-    /// The most recent stations' fused landmarks, placed around each station, with the
-    /// station's index.
-    frames: Vec<(usize, Frame)>,
+    /// The fused landmarks of the stations within the sketch's window, placed around each
+    /// station, with the station's index.
+    history: Vec<(usize, Frame)>,
     /// The recently seen landmarks placed in one coordinate system.
     sketch: Sketch,
+    /// When each landmark was last fused.
+    last_seen: LastSeen,
     /// Held-back observations given up after [`HOLD_STATIONS`].
     pub expired: usize,
     next_landmark: LandmarkId,
@@ -86,8 +89,9 @@ impl<C: Calculus> Mapper<C> {
             sensor,
             association,
             held: Vec::new(),
-            frames: Vec::new(),
+            history: Vec::new(),
             sketch: Sketch::default(),
+            last_seen: LastSeen::default(),
             expired: 0,
             next_landmark: 0,
             sightings: Vec::new(),
@@ -173,14 +177,21 @@ impl<C: Calculus> Mapper<C> {
         // sparse-large seed 3, after 47 stations that fused too few landmarks to push a new
         // frame, station 51 registered six look-alikes of stations 0–3's rocks by chance
         // (67 unsound relations).
+        self.history
+            .retain(|(station, _)| index <= station + sketch::WINDOW);
+        let mut recent: Vec<Frame> = self
+            .history
+            .iter()
+            .rev()
+            .map(|(_, frame)| frame)
+            .filter(|frame| frame.registrable())
+            .take(RECENT_FRAMES)
+            .cloned()
+            .collect();
+        recent.reverse();
         let frames: Vec<Frame> = std::iter::once(self.sketch.frame(index))
             .filter(Frame::registrable)
-            .chain(
-                self.frames
-                    .iter()
-                    .filter(|(station, _)| index <= station + sketch::WINDOW)
-                    .map(|(_, frame)| frame.clone()),
-            )
+            .chain(recent)
             .collect();
         let decisions = associate(
             &self.map,
@@ -188,7 +199,9 @@ impl<C: Calculus> Mapper<C> {
             &frames,
             &evidence,
             &self.association,
+            &|landmark| self.last_seen.lately(landmark, index),
         );
+        let decisions = self.undo_disagreeing(decisions, &evidence.detections);
         record.seconds.associate = start.elapsed().as_secs_f64();
 
         let start = Instant::now();
@@ -207,6 +220,33 @@ impl<C: Calculus> Mapper<C> {
         record.metrics = self.refresh_metrics();
         record.seconds.metrics = start.elapsed().as_secs_f64();
         record
+    }
+
+    /// The decisions with every match whose landmark an earlier station placed elsewhere
+    /// ([`agreement`]) held back, the landmark its only candidate: the detection is another
+    /// rock, which may have a landmark of its own, so it is not made a new one on the spot.
+    fn undo_disagreeing(
+        &self,
+        mut decisions: Vec<Decision>,
+        evidence: &[Evidence],
+    ) -> Vec<Decision> {
+        let matched: Vec<(LandmarkId, Placed)> = decisions
+            .iter()
+            .zip(evidence)
+            .filter_map(|(decision, e)| match decision {
+                Decision::Matched(l) => Some((*l, e.placed?)),
+                _ => None,
+            })
+            .collect();
+        let disagreeing = agreement::disagreeing(&matched, self.history.iter().map(|(_, f)| f));
+        for decision in &mut decisions {
+            if let Decision::Matched(l) = *decision {
+                if disagreeing.contains(&l) {
+                    *decision = Decision::HeldBack(vec![l]);
+                }
+            }
+        }
+        decisions
     }
 
     /// The size cue, for landmarks whose width earlier stations bounded (not for parts of a
@@ -278,6 +318,7 @@ impl<C: Calculus> Mapper<C> {
             self.gallery
                 .observe(s.landmark, evidence.appearance.clone(), evidence.width);
             self.sightings.push((record.index, i, s.landmark));
+            self.last_seen.record(s.landmark, record.index);
             record.detections[i].association = match associated.decisions[s.position] {
                 Decision::New => Association::New {
                     landmark: s.landmark,
@@ -296,15 +337,7 @@ impl<C: Calculus> Mapper<C> {
                 .collect(),
         };
         self.sketch.update(record.index, &frame.landmarks);
-        // A station that fused too few landmarks to register against does not push an older,
-        // useful one out: with no registrable frame left, every rock would come back as a new
-        // landmark.
-        if frame.registrable() {
-            self.frames.push((record.index, frame));
-            if self.frames.len() > RECENT_FRAMES {
-                self.frames.remove(0);
-            }
-        }
+        self.history.push((record.index, frame));
     }
 
     /// Keeps the station's undecided detections to be tried again on a tighter map.
@@ -378,6 +411,7 @@ impl<C: Calculus> Mapper<C> {
                     );
                     self.sightings
                         .push((item.station, item.primary_index, landmark));
+                    self.last_seen.record(landmark, item.station);
                     resolved += 1;
                     // The station's other held observations now have this detection's
                     // landmark as a partner to measure with.
@@ -429,7 +463,9 @@ impl<C: Calculus> Mapper<C> {
 }
 
 /// Recent stations registered against (a rover moves a few metres between stations: the most
-/// recent ones share most landmarks with the current one).
+/// recent ones share most landmarks with the current one). Only stations that fused enough
+/// landmarks to register against count: with no registrable frame left, every rock would come
+/// back as a new landmark.
 const RECENT_FRAMES: usize = 6;
 
 /// Stations a held-back observation waits for the map to tighten before it is given up (an
