@@ -13,7 +13,7 @@ use super::palette::curve_colour;
 use super::ticks::tick_formatter;
 use plotters::coord::Shift;
 use plotters::prelude::{
-    ChartBuilder, DrawingArea, DrawingAreaErrorKind, DrawingBackend, LineSeries, Polygon,
+    ChartBuilder, Circle, DrawingArea, DrawingAreaErrorKind, DrawingBackend, PathElement, Polygon,
 };
 use plotters::style::{Color, IntoFont, RGBColor, WHITE};
 use std::ops::Range;
@@ -299,14 +299,20 @@ fn draw_panel<DB: DrawingBackend>(
                 .collect();
             chart.draw_series(std::iter::once(Polygon::new(band, colour.mix(0.18))))?;
         }
-        let mean = curve
+        let mean: Vec<(f64, f64)> = curve
             .mean
             .iter()
             .enumerate()
-            .map(|(i, &m)| (panel.x_at(i), m));
+            .map(|(i, &m)| (panel.x_at(i), m))
+            .collect();
+        // Segment by segment: a thick polyline's mitred joins shoot spikes far past the chart
+        // where a dense curve jumps up and straight back down (a per-station time series).
+        let style = colour.stroke_width(3);
+        chart.draw_series(mean.windows(2).map(|w| PathElement::new(w.to_vec(), style)))?;
         // A one-image curve is a single point, which a line alone would not show.
-        let marker = if curve.mean.len() == 1 { 5 } else { 0 };
-        chart.draw_series(LineSeries::new(mean, colour.stroke_width(3)).point_size(marker))?;
+        if let [point] = mean[..] {
+            chart.draw_series(std::iter::once(Circle::new(point, 5, style.filled())))?;
+        }
     }
     Ok(())
 }

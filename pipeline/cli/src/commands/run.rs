@@ -573,6 +573,8 @@ fn timing_panels(records: &[StationRecord]) -> Vec<Panel> {
                 }),
                 curve("associate", &|r| r.seconds.associate),
                 curve("measure and fuse", &|r| r.seconds.map),
+                curve("map metrics and RNG estimate", &|r| r.seconds.metrics),
+                curve("recording (MCAP)", &|r| r.seconds.recording),
             ],
             x: Vec::new(),
         },
