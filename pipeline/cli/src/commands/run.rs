@@ -333,8 +333,16 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
         .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
     let mut recorders = recorders(args)?;
     let mapper: Mapper<Edc> = Mapper::new(calib, settings.sensor, settings.association);
+    let mut drawing = None;
     let traverse = map_stations(&detected, mapper, &bars, |record, mapper| {
-        record_station(&mut recorders, record, mapper, &survey, &calib)
+        record_station(
+            &mut recorders,
+            &mut drawing,
+            record,
+            mapper,
+            &survey,
+            &calib,
+        )
     })?;
     let writing = Instant::now();
 
@@ -418,8 +426,11 @@ fn load_calibration(args: &RunArgs) -> Result<Calibration> {
 }
 
 /// Hands one mapped station to every recorder, with its panorama for those that show it.
+/// `drawing` keeps the RNG drawing of the map's latest revision: laying out every edge of a
+/// long drive's map takes longer than mapping a station, and an unchanged map draws the same.
 fn record_station(
     recorders: &mut [Box<dyn Recorder>],
+    drawing: &mut Option<(u64, RngDrawing)>,
     record: &StationRecord,
     mapper: &Mapper<Edc>,
     survey: &Survey,
@@ -432,7 +443,14 @@ fn record_station(
     } else {
         no_image.clone()
     };
-    let drawing = rng_drawing(&mapper.map, mapper.rng());
+    if drawing
+        .as_ref()
+        .is_some_and(|(revision, _)| *revision != mapper.revision())
+    {
+        *drawing = None;
+    }
+    let (_, drawing) =
+        drawing.get_or_insert_with(|| (mapper.revision(), rng_drawing(&mapper.map, mapper.rng())));
     for recorder in recorders.iter_mut() {
         let image = if recorder.wants_panorama() {
             &panorama
@@ -440,7 +458,7 @@ fn record_station(
             &no_image
         };
         recorder.station(record, image)?;
-        recorder.rng(record.index, &drawing)?;
+        recorder.rng(record.index, &*drawing)?;
     }
     Ok(())
 }

@@ -78,6 +78,11 @@ pub struct Mapper<C: Calculus> {
     pub sightings: Vec<(usize, usize, LandmarkId)>,
     /// The RNG estimate after the latest station.
     rng: RngEstimate,
+    /// Counts the changes of the map: a station that fused nothing new leaves it, and its
+    /// metrics and RNG estimate are those of the station before.
+    revision: u64,
+    /// The metrics of the map at `revision`, if computed.
+    metrics: Option<(u64, MetricsRecord)>,
 }
 
 impl<C: Calculus> Mapper<C> {
@@ -96,6 +101,8 @@ impl<C: Calculus> Mapper<C> {
             next_landmark: 0,
             sightings: Vec::new(),
             rng: RngEstimate::default(),
+            revision: 0,
+            metrics: None,
         }
     }
 
@@ -288,12 +295,16 @@ impl<C: Calculus> Mapper<C> {
         };
         record.fusion.landmarks = associated.fused.len();
         record.fusion.triples = batch.len() / 3;
+        let before = self.map.len();
         match self.map.fuse(&batch) {
             Ok(report) => {
                 record.fusion.relations_tightened = report.relations_tightened;
                 // Without a triple, the landmarks decided here enter the map unrelated.
                 let decided: Vec<_> = associated.fused.iter().map(|s| s.landmark).collect();
                 self.map.add_landmarks(&decided);
+                if report.relations_tightened > 0 || self.map.len() != before {
+                    self.revision += 1;
+                }
                 self.next_landmark = associated.next_landmark;
                 self.remember(record, &associated);
                 self.hold_back(record, associated, view);
@@ -403,6 +414,7 @@ impl<C: Calculus> Mapper<C> {
             );
             match self.map.fuse(&batch) {
                 Ok(_) => {
+                    self.revision += 1;
                     self.next_landmark += 1;
                     self.gallery.observe(
                         landmark,
@@ -442,10 +454,28 @@ impl<C: Calculus> Mapper<C> {
         &self.rng
     }
 
+    /// Counts the changes of the map (see [`Mapper::rng`]): equal revisions, equal maps.
+    pub fn revision(&self) -> u64 {
+        self.revision
+    }
+
     /// The map's state after a station; the RNG estimate is computed once here and kept for
     /// [`Mapper::rng`] (on a long drive it is the costliest per-station query: every pair of
-    /// landmarks against every third).
+    /// landmarks against every third), and neither is computed again while the map is
+    /// unchanged (on the 1 000-rock drive, half the stations fuse nothing new).
     fn refresh_metrics(&mut self) -> MetricsRecord {
+        match &self.metrics {
+            Some((revision, metrics)) if *revision == self.revision => metrics.clone(),
+            _ => {
+                let metrics = self.measure_map();
+                self.metrics = Some((self.revision, metrics.clone()));
+                metrics
+            }
+        }
+    }
+
+    /// The map's metrics and RNG estimate, computed afresh.
+    fn measure_map(&mut self) -> MetricsRecord {
         let triples = self.map.triple_count();
         let states = 3 * triples * C::universe().len();
         self.rng = estimate(&self.map).unwrap_or_default();
