@@ -21,8 +21,8 @@ use qrm_core::map::LandmarkId;
 pub const FEWEST_OTHERS: usize = 3;
 
 /// The landmarks of `current` (matched at this station, placed around it) whose placement
-/// disagrees with theirs at one of the `earlier` stations: off the motion ([`Motion::agreed`])
-/// that at least [`FEWEST_OTHERS`] other shared landmarks agree on.
+/// disagrees with theirs at one of the `earlier` stations: off the motion that at least
+/// [`FEWEST_OTHERS`] other shared landmarks agree on ([`Motion::agreed`]).
 pub fn disagreeing<'f>(
     current: &[(LandmarkId, Placed)],
     earlier: impl IntoIterator<Item = &'f Frame>,
@@ -38,7 +38,7 @@ pub fn disagreeing<'f>(
                 })
                 .collect();
             let pairs: Vec<(Placed, Placed)> = shared.iter().map(|s| s.1).collect();
-            let agree = Motion::agreed(&pairs, FEWEST_OTHERS).map(|(_, agree)| agree);
+            let agree = Motion::agreed(&pairs, FEWEST_OTHERS);
             shared
                 .iter()
                 .zip(agree.unwrap_or_default())

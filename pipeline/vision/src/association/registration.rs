@@ -472,13 +472,12 @@ impl Motion {
         }
     }
 
-    /// The motion most of `pairs` agree on (each `.0` within placement tolerance of its `.1`,
-    /// [`misfit`]), and which pairs agree: every motion taking one pair onto its partner and
-    /// the direction to a second pair onto its partner's is tried, and the one most pairs
-    /// agree with is refitted on those pairs by least squares. Unlike [`Motion::consensus`]
-    /// a pair that is off does not pull the fit: it never takes part in it. None when fewer
-    /// than `fewest` pairs agree.
-    pub(super) fn agreed(pairs: &[(Placed, Placed)], fewest: usize) -> Option<(Motion, Vec<bool>)> {
+    /// Which of `pairs` agree on one motion (each `.0` within placement tolerance of its `.1`,
+    /// [`misfit`]): every motion taking one pair onto its partner and the direction to a
+    /// second pair onto its partner's is tried, and the one most pairs agree with is refitted
+    /// on those pairs by least squares. Unlike [`Motion::consensus`] a pair that is off does
+    /// not pull the fit: it never takes part in it. None when fewer than `fewest` pairs agree.
+    pub(super) fn agreed(pairs: &[(Placed, Placed)], fewest: usize) -> Option<Vec<bool>> {
         let agreeing = |motion: &Motion| -> Vec<bool> {
             pairs
                 .iter()
@@ -508,9 +507,8 @@ impl Motion {
             .filter(|(_, &a)| a)
             .map(|((p, q), _)| (p.point, q.point))
             .collect();
-        let motion = Motion::fit(&fitted);
-        let agree = agreeing(&motion);
-        (count(&agree) >= fewest).then_some((motion, agree))
+        let agree = agreeing(&Motion::fit(&fitted));
+        (count(&agree) >= fewest).then_some(agree)
     }
 
     pub(super) fn apply(&self, p: [f64; 2]) -> [f64; 2] {
