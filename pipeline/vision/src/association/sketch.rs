@@ -13,7 +13,7 @@
 //! and is never fed a metric position. Landmarks not seen for [`WINDOW`] stations leave the
 //! sketch, so its drift over a long traverse never reaches the registration.
 
-use super::registration::{distance, Frame, Motion, Placed};
+use super::registration::{misfit, Frame, Motion, Placed};
 use qrm_core::map::LandmarkId;
 
 /// Stations a landmark stays in the sketch after it was last seen (a rover moves 1–2 m a
@@ -27,9 +27,6 @@ const DECAY: f64 = 0.7;
 /// Smallest radius of a sketched position, metres: rocks are not points, and a range
 /// interval's middle is not the rock's centre.
 const MIN_RADIUS_M: f64 = 0.25;
-
-/// Slack of the test of a placement against its landmark's estimate, metres.
-const SLACK_M: f64 = 0.3;
 
 /// Fewest shared landmarks that fix a station's motion into the sketch.
 const MIN_SHARED: usize = 3;
@@ -116,9 +113,7 @@ impl Sketch {
     fn merge(&mut self, landmark: LandmarkId, placed: Placed, station: usize) {
         let weight = placed.radius.powi(-2);
         match self.landmarks.iter_mut().find(|s| s.landmark == landmark) {
-            Some(s)
-                if distance(s.placed.point, placed.point)
-                    > s.placed.radius + placed.radius + SLACK_M => {}
+            Some(s) if misfit(&Motion::identity(), placed, s.placed) > 0.0 => {}
             Some(s) => {
                 let old = DECAY * s.weight;
                 let total = old + weight;
@@ -146,6 +141,7 @@ impl Sketch {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::association::registration::distance;
     use crate::association::registration::tests::FIELD;
 
     fn placed(point: [f64; 2]) -> Placed {
