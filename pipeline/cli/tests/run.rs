@@ -134,6 +134,79 @@ fn maps_the_demo_dataset_soundly() {
     assert_eq!(json(&again.join("eval.json")), eval);
 }
 
+/// `--mode probabilistic` writes 002's beliefs beside the same map of sets, keyed by its
+/// landmarks and normalized, says how they were made in summary.json and scores them in
+/// eval.json; a deterministic run into the same directory removes the stale beliefs.
+#[test]
+fn maps_the_demo_with_beliefs() {
+    let images = demo_copy("beliefs", 6);
+    let (plain, out) = (scratch("beliefs-plain"), scratch("beliefs-out"));
+    let o = pipeline(&["run", "--images", arg(&images), "--out", arg(&plain)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = pipeline(&[
+        "run",
+        "--images",
+        arg(&images),
+        "--out",
+        arg(&out),
+        "--mode",
+        "probabilistic",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        json(&out.join("map.json")),
+        json(&plain.join("map.json")),
+        "the map of sets does not depend on the mode"
+    );
+    let landmarks: Vec<u64> = json(&out.join("map.json"))["landmarks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_u64().unwrap())
+        .collect();
+    let beliefs = json(&out.join("beliefs.json"));
+    assert_eq!(beliefs["format"], "qrm-beliefs");
+    let triples = beliefs["triples"].as_array().unwrap();
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(
+        summary["beliefs"]["triples"].as_u64().unwrap() as usize,
+        triples.len(),
+        "{summary}"
+    );
+    assert!(!triples.is_empty());
+    for t in triples {
+        let ids = ["a", "b", "c"].map(|k| t[k].as_u64().unwrap());
+        assert!(ids[0] < ids[1] && ids[1] < ids[2]);
+        assert!(ids.iter().all(|id| landmarks.contains(id)), "{t}");
+        let p: Vec<f64> = serde_json::from_value(t["ab_c"].clone()).unwrap();
+        assert_eq!(p.len(), 20);
+        assert!((p.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+    }
+    let eval = json(&out.join("eval.json"));
+    let scored = &eval["beliefs"];
+    assert!(scored["triples"].as_u64().unwrap() > 0, "{eval}");
+    assert_eq!(scored["truth_in_set"], scored["triples"], "{eval}");
+    assert!(json(&plain.join("eval.json")).get("beliefs").is_none());
+    let o = pipeline(&["run", "--images", arg(&images), "--out", arg(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!out.join("beliefs.json").exists(), "stale beliefs left");
+    let bad = scratch("beliefs-bad");
+    let o = pipeline(&[
+        "run",
+        "--images",
+        arg(&images),
+        "--out",
+        arg(&bad.join("out")),
+        "--mode",
+        "probabilistic",
+        "--views",
+        "1",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--views"), "{}", stderr(&o));
+    assert!(!bad.join("out").exists(), "nothing is written");
+}
+
 /// The (width, height) of the PNG at `path`, from its header.
 fn png_size(path: &Path) -> (u32, u32) {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));

@@ -8,6 +8,7 @@ use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
 use qrm_core::map::{Hypergraph, LandmarkId};
 use qrm_core::neighborhood::estimate;
+use qrm_core::probabilistic::map::BeliefMap;
 use qrm_synth::dataset::{Truth, TRUTH_FORMAT, TRUTH_VERSION};
 use qrm_synth::evaluation::{self, Detectable, Evaluation, RunFiles};
 use qrm_vision::calib::Calibration;
@@ -111,6 +112,14 @@ pub fn score_run_files(
         .with_context(|| format!("cannot read {}", map_path.display()))?;
     let map = Hypergraph::<Edc>::from_json(&map_text)
         .with_context(|| format!("{}", map_path.display()))?;
+    let beliefs_path = run_dir.join("beliefs.json");
+    let beliefs = match std::fs::read_to_string(&beliefs_path) {
+        Ok(text) => Some(
+            BeliefMap::from_json(&text).with_context(|| format!("{}", beliefs_path.display()))?,
+        ),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+        Err(e) => return Err(e).with_context(|| format!("cannot read {}", beliefs_path.display())),
+    };
     if let Err(problem) = evaluation::check_files(&truth, &records, &landmarks) {
         bail!(
             "{} does not fit the run in {}: {problem}",
@@ -124,6 +133,7 @@ pub fn score_run_files(
             records: &records,
             landmarks: &landmarks,
             map: &map,
+            beliefs: beliefs.as_ref(),
         },
         &truth,
         calib,
@@ -233,6 +243,19 @@ pub fn print_report(e: &Evaluation) {
                 worst.join(", ")
             );
         }
+    }
+    if let Some(c) = &e.beliefs {
+        let pct = |n: usize| 100.0 * n as f64 / c.triples.max(1) as f64;
+        println!(
+            "  002 beliefs ({} triples with a belief and a truth): truth most likely {:.1} %, in the belief's support {:.1} %, median DMSE {:.3}; the map's set holds the truth {:.1} % (mean {:.2} states); beliefs conditioned on the map put the truth first {:.1} %",
+            c.triples,
+            pct(c.truth_most_likely),
+            pct(c.truth_in_support),
+            c.median_dmse,
+            pct(c.truth_in_set),
+            c.mean_set_size,
+            pct(c.conditioned_truth_most_likely)
+        );
     }
     for (name, rng) in [("run", &e.map.rng), ("exact", &e.map.rng_exact)] {
         if let Some(rng) = rng {

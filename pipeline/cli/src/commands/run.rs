@@ -3,6 +3,7 @@
 use super::pictures::{stage_pictures, PanoramaSize, RunImages};
 use super::rng_json;
 use super::rng_picture::{stage_rng_png, EdgeCut, DEFAULT_MAX_COST};
+use super::simulate::{EstimatorArgs, Mode};
 use crate::recording::{McapRecorder, Recorder, RngDrawing};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -12,12 +13,15 @@ use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
 use qrm_core::neighborhood::RngEstimate;
+use qrm_core::probabilistic::map::Variant;
 use qrm_plot::{spring_layout, write_panels, Curve, Panel};
 use qrm_synth::evaluation::Evaluation;
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::Channels;
+use qrm_vision::run::beliefs::{bearing_sd, run_beliefs};
 use qrm_vision::run::{
-    detect_survey, map_stations, Mapper, Progress, RunSettings, RunSummary, Stage, StationRecord,
+    detect_survey, map_stations, BeliefsSummary, Mapper, Progress, RunSettings, RunSummary, Stage,
+    StationRecord,
 };
 use qrm_vision::survey::{read_image, Survey};
 use std::path::{Path, PathBuf};
@@ -63,6 +67,14 @@ pub struct RunArgs {
     /// at the end (each station's are in stations.json).
     #[arg(long)]
     pub quiet: bool,
+    /// `probabilistic`: also 002's beliefs (Mor & Indelman) over the 20 EDC states of every
+    /// triple fused together at two or more stations, in beliefs.json beside map.json, the
+    /// motion between two stations taken from their stereo placements (docs/PROBABILISTIC.md).
+    /// The map of sets is the same in both modes.
+    #[arg(long, value_enum, default_value = "deterministic")]
+    pub mode: Mode,
+    #[command(flatten)]
+    pub beliefs: EstimatorArgs,
 }
 
 /// `--channels` (`qrm_vision::detection::Channels`).
@@ -82,6 +94,9 @@ impl From<ChannelsArg> for Channels {
         }
     }
 }
+
+/// The seed of 002's particles in `--mode probabilistic`: a run's beliefs are reproducible.
+const BELIEF_SEED: u64 = 1;
 
 /// The recorders of the run: run.mcap always, run.rrd on request.
 fn recorders(args: &RunArgs) -> Result<Vec<Box<dyn Recorder>>> {
@@ -266,6 +281,7 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
         );
     }
     let calib = load_calibration(args)?;
+    let estimator = args.beliefs.estimator()?;
     // The truth, given or found in the image directory, is read before any work: a bad one
     // would otherwise fail only once the run's outputs had replaced the earlier ones. A given
     // one must also describe every image (a found one is checked image by image when scoring,
@@ -344,6 +360,26 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
             &calib,
         )
     })?;
+    let beliefs = match args.mode {
+        Mode::Deterministic => None,
+        Mode::Probabilistic => {
+            let start = Instant::now();
+            let sighted = &traverse.mapper.sighted;
+            let beliefs = run_beliefs(sighted, &estimator, BELIEF_SEED);
+            let summary = BeliefsSummary {
+                estimator: match estimator.variant {
+                    Variant::Fast => "fast",
+                    Variant::Full => "full",
+                }
+                .to_string(),
+                triples_seen_twice: beliefs.seen_twice,
+                triples: beliefs.triples.len(),
+                bearing_sd_deg: bearing_sd(sighted).to_degrees(),
+                wall_seconds: start.elapsed().as_secs_f64(),
+            };
+            Some((beliefs, summary))
+        }
+    };
     let writing = Instant::now();
 
     // Every output is staged and then renamed in one pass: an earlier run's files are all
@@ -357,6 +393,13 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
         &traverse.records,
         cut,
     )?;
+    if let Some((beliefs, _)) = &beliefs {
+        stage(
+            &mut outputs,
+            &args.out.join("beliefs.json"),
+            beliefs.to_json(&estimator).as_bytes(),
+        )?;
+    }
     let landmarks = traverse.mapper.landmarks();
     let images = RunImages {
         directory: &survey.directory,
@@ -372,6 +415,8 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
     }
     let mut summary = traverse.summary(detected.wall_seconds);
     summary.wall_checks = checks_seconds;
+    let beliefs_absent = beliefs.is_none();
+    summary.beliefs = beliefs.map(|(_, summary)| summary);
     summary.wall_outputs = writing.elapsed().as_secs_f64();
     stage(
         &mut outputs,
@@ -382,6 +427,9 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
     // new one is written after the run's files are in place.
     outputs.remove_stale(&args.out.join("eval.json"));
     outputs.remove_stale(&args.out.join("rng_truth.png"));
+    if beliefs_absent {
+        outputs.remove_stale(&args.out.join("beliefs.json"));
+    }
     outputs
         .commit()
         .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;

@@ -12,7 +12,8 @@ use qrm_core::geometry::Point;
 use qrm_core::map::{Hypergraph, Sighting};
 use qrm_core::measurement::MAX_BEARING_UNCERTAINTY;
 use qrm_core::neighborhood::{estimate, true_rng};
-use qrm_core::simulation::beliefs::{beliefs, compare, BeliefSettings, Variant};
+use qrm_core::probabilistic::map::{Estimator, Variant};
+use qrm_core::simulation::beliefs::{beliefs, compare, BeliefSettings};
 use qrm_core::simulation::{
     run, MonteCarlo, MonteCarloResult, Scenario, Sensor, Series, Statistic,
 };
@@ -155,38 +156,58 @@ pub enum Mode {
     Probabilistic,
 }
 
-/// How `--mode probabilistic` makes its beliefs.
+/// How `--mode probabilistic` makes its beliefs in the simulator.
 #[derive(Args, Debug)]
 pub struct BeliefArgs {
-    /// 002's estimator: `fast` (§III-D) or `full` (Algorithm 1).
-    #[arg(long, value_enum, default_value = "fast")]
-    estimator: Estimator,
-    /// Views per triple: the first imaging points that see it (002: 3 time steps).
-    #[arg(long, default_value_t = 3)]
-    views: usize,
+    #[command(flatten)]
+    estimator: EstimatorArgs,
     /// Noise of 002's motion command (heading of the displacement between two views, which
     /// the deterministic map does not use), s.d. in degrees.
     #[arg(long, default_value_t = 2.0)]
     motion_noise: f64,
+}
+
+/// Which of 002's estimators makes the beliefs of `--mode probabilistic`, and how.
+#[derive(Args, Debug)]
+pub struct EstimatorArgs {
+    /// 002's estimator: `fast` (§III-D) or `full` (Algorithm 1).
+    #[arg(long, value_enum, default_value = "fast")]
+    estimator: EstimatorName,
+    /// Views per triple: the first stations that see it (002: 3 time steps).
+    #[arg(long, default_value_t = 3)]
+    views: usize,
     /// Particles per triple.
     #[arg(long, default_value_t = 300)]
     particles: usize,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Estimator {
+pub enum EstimatorName {
     Fast,
     Full,
 }
 
-impl BeliefArgs {
-    fn settings(&self) -> Result<BeliefSettings> {
+impl EstimatorArgs {
+    pub(super) fn estimator(&self) -> Result<Estimator> {
         if self.views < 2 {
             bail!("--views must be at least 2: 002 resects C from two views or more");
         }
         if self.particles == 0 {
             bail!("--particles must be positive");
         }
+        Ok(Estimator {
+            variant: match self.estimator {
+                EstimatorName::Fast => Variant::Fast,
+                EstimatorName::Full => Variant::Full,
+            },
+            views: self.views,
+            particles: self.particles,
+        })
+    }
+}
+
+impl BeliefArgs {
+    fn settings(&self) -> Result<BeliefSettings> {
         if !(0.0..=60.0).contains(&self.motion_noise) {
             bail!(
                 "--motion-noise {} must lie in [0, 60] degrees",
@@ -194,13 +215,8 @@ impl BeliefArgs {
             );
         }
         Ok(BeliefSettings {
-            variant: match self.estimator {
-                Estimator::Fast => Variant::Fast,
-                Estimator::Full => Variant::Full,
-            },
-            views: self.views,
+            estimator: self.estimator.estimator()?,
             motion_noise: self.motion_noise.to_radians(),
-            particles: self.particles,
         })
     }
 }
@@ -571,11 +587,11 @@ fn probabilistic_single(
     let pct = |n: usize| 100.0 * n as f64 / c.triples.max(1) as f64;
     println!(
         "002 beliefs ({} estimator, ≤ {} views, motion noise {}°) for {} triples seen from two or more points, in {elapsed:.2} s:",
-        match settings.variant {
+        match settings.estimator.variant {
             Variant::Fast => "fast",
             Variant::Full => "full",
         },
-        settings.views,
+        settings.estimator.views,
         args.beliefs.motion_noise,
         c.triples
     );

@@ -3,6 +3,7 @@
 //! with the offline tensor of 002 §III-E, and the metrics of 002 §IV.
 
 mod belief;
+pub mod map;
 mod metrics;
 pub mod study;
 mod tensor;

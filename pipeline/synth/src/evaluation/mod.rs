@@ -1,7 +1,8 @@
 //! Scoring a `pipeline run` against the renderer's ground truth (`truth.json`): detection,
 //! bearings, range cues and order ([`front_end`]), association ([`association`]), and the map
 //! against one built from exact measurements of the same landmarks at the same stations
-//! ([`map`]). Pure: files are read and written by the CLI.
+//! ([`map`]), and 002's beliefs if the run made them. Pure: files are read and written by the
+//! CLI.
 
 mod association;
 pub mod detection;
@@ -11,8 +12,11 @@ mod map;
 pub use detection::{match_detections, median_and_max, Detectable, DetectedBox, Score};
 
 use crate::dataset::{ImageTruth, Truth};
+use qrm_core::calculus::Calculus;
 use qrm_core::edc::Edc;
+use qrm_core::geometry::Point;
 use qrm_core::map::{Hypergraph, LandmarkId};
+use qrm_core::probabilistic::map::{compare, BeliefComparison, BeliefMap};
 use qrm_vision::calib::Calibration;
 use qrm_vision::run::{LandmarkRecord, StationRecord};
 use serde::Serialize;
@@ -31,6 +35,10 @@ pub struct Evaluation {
     /// only of false detections have none).
     pub landmark_rocks: BTreeMap<LandmarkId, u32>,
     pub map: MapScore,
+    /// `--mode probabilistic`: 002's beliefs and the map's sets against the truth, over the
+    /// triples with a belief, each landmark held to its majority rock.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub beliefs: Option<BeliefComparison>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -249,6 +257,8 @@ pub struct RunFiles<'a> {
     pub records: &'a [StationRecord],
     pub landmarks: &'a [LandmarkRecord],
     pub map: &'a Hypergraph<Edc>,
+    /// The run's beliefs.json, if it wrote one.
+    pub beliefs: Option<&'a BeliefMap>,
 }
 
 /// Scores a run. `detectable` says which rocks count for recall.
@@ -272,6 +282,15 @@ pub fn score_run(
         association,
         landmark_rocks: rocks.all(),
         map: map::score(run, truth, &rocks),
+        beliefs: run.beliefs.map(|beliefs| {
+            let rock = |l: LandmarkId| {
+                let p = truth.rocks[rocks.majority(l)? as usize].position;
+                Some(Point::new(p[0], p[1]))
+            };
+            compare(beliefs, run.map, &|[a, b, c]| {
+                Edc::classify(rock(a)?, rock(b)?, rock(c)?)
+            })
+        }),
     }
 }
 

@@ -44,7 +44,7 @@ pub mod sketch;
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
 pub use recency::LastSeen;
 use registration::MIN_INLIERS;
-pub use registration::{register, Frame, Placed, Registration};
+pub use registration::{displacement, register, Frame, Placed, Registration};
 pub use sketch::Sketch;
 
 use crate::detection::Appearance;

@@ -376,6 +376,41 @@ impl Registration {
     }
 }
 
+/// The displacement from an `earlier` station to a `later` one, seen from the earlier camera:
+/// the heading of the later station (radians, the bearings' convention) and its s.d., from
+/// the rigid motion that brings the landmarks both frames placed together
+/// ([`Motion::consensus`], at least [`MIN_INLIERS`] of them). This is the motion command of
+/// 002's probabilistic map, which a rover without odometry does not have. `None` when too few
+/// landmarks agree, or when the station moved less than twice the shift's s.d.
+///
+/// A placement's radius bounds its error (about two s.d.); the shift's s.d. is that of the
+/// mean of the pairs' errors, doubled for the rotation's share.
+pub fn displacement(earlier: &Frame, later: &Frame) -> Option<(f64, f64)> {
+    let pairs: Vec<(Placed, Placed)> = later
+        .landmarks
+        .iter()
+        .filter_map(|(l, p)| {
+            let (_, q) = earlier.landmarks.iter().find(|(m, _)| m == l)?;
+            Some((*p, *q))
+        })
+        .collect();
+    let motion = Motion::consensus(pairs.clone(), MIN_INLIERS)?;
+    let agreeing: Vec<&(Placed, Placed)> = pairs
+        .iter()
+        .filter(|(p, q)| misfit(&motion, *p, *q) <= 0.0)
+        .collect();
+    let n = agreeing.len() as f64;
+    let variance = agreeing
+        .iter()
+        .map(|(p, q)| (p.radius.powi(2) + q.radius.powi(2)) / 4.0)
+        .sum::<f64>()
+        / n;
+    let shift_sd = 2.0 * (variance / n).sqrt();
+    let [x, y] = motion.shift;
+    let moved = x.hypot(y);
+    (moved >= 2.0 * shift_sd).then(|| (y.atan2(x), shift_sd.atan2(moved)))
+}
+
 /// How far `motion` leaves `p` beyond the placement radii of `p` and `q` and the slack,
 /// metres: positive when the two placements cannot be one rock under that motion.
 pub(super) fn misfit(motion: &Motion, p: Placed, q: Placed) -> f64 {
@@ -591,6 +626,43 @@ pub(super) mod tests {
                 .map(|(k, &point)| (k as LandmarkId, Placed { point, radius: 0.3 }))
                 .collect(),
         }
+    }
+
+    /// FIELD seen from a station at `at`, turned by `turn`: each rock in that station's frame.
+    fn seen_from(at: [f64; 2], turn: f64, radius: f64) -> Frame {
+        let (sin, cos) = turn.sin_cos();
+        Frame {
+            accumulated: false,
+            landmarks: FIELD
+                .iter()
+                .enumerate()
+                .map(|(k, p)| {
+                    let (x, y) = (p[0] - at[0], p[1] - at[1]);
+                    let point = [cos * x + sin * y, -sin * x + cos * y];
+                    (k as LandmarkId, Placed { point, radius })
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn the_displacement_between_two_stations_is_the_later_ones_heading_from_the_earlier() {
+        let earlier = field_frame();
+        // The later station is 2 m out at 30° from the earlier one, turned by 1 rad.
+        let heading = 30f64.to_radians();
+        let later = seen_from([2.0 * heading.cos(), 2.0 * heading.sin()], 1.0, 0.3);
+        let (angle, sd) = displacement(&earlier, &later).expect("six landmarks shared");
+        assert!((angle - heading).abs() < 1e-9, "{angle}");
+        // Six pairs of radius 0.3 m (s.d. 0.15 m each): shift s.d. 2·0.15·√2/√6 ≈ 0.17 m.
+        assert!(
+            (sd - (0.3f64 / 3f64.sqrt()).atan2(2.0)).abs() < 1e-9,
+            "{sd}"
+        );
+        // A move within the placements' noise has no heading; too few shared landmarks, none.
+        assert!(displacement(&earlier, &seen_from([0.2, 0.0], 1.0, 0.3)).is_none());
+        let mut few = later.clone();
+        few.landmarks.truncate(MIN_INLIERS - 1);
+        assert!(displacement(&earlier, &few).is_none());
     }
 
     #[test]

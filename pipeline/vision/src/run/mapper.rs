@@ -13,8 +13,9 @@ use crate::detection::{Detection, Separation};
 use crate::ranging::{self, PrimaryEye, Ranged, SensorModel};
 use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
-use qrm_core::measurement::StationView;
+use qrm_core::measurement::{Bearing, StationView};
 use qrm_core::neighborhood::{estimate, RngEstimate};
+use std::collections::BTreeMap;
 use std::time::Instant;
 
 /// One station's detections, ready for mapping.
@@ -40,6 +41,16 @@ pub struct LandmarkRecord {
     pub landmark: LandmarkId,
     pub sightings: Vec<(usize, usize)>,
     pub profile: crate::association::Profile,
+}
+
+/// One station's fused landmarks as 002's probabilistic map needs them: each one's bearing
+/// (radians, camera frame) with its bound, and the station's frame of placements, from
+/// which the motion between two stations is found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sighted {
+    pub station: usize,
+    pub bearings: BTreeMap<LandmarkId, Bearing>,
+    pub frame: Frame,
 }
 
 /// An observation whose association stayed ambiguous, kept to be fused later.
@@ -71,6 +82,8 @@ pub struct Mapper<C: Calculus> {
     sketch: Sketch,
     /// When each landmark was last fused.
     last_seen: LastSeen,
+    /// Every station that fused landmarks, for 002's beliefs (`super::beliefs`).
+    pub sighted: Vec<Sighted>,
     /// Held-back observations given up after [`HOLD_STATIONS`].
     pub expired: usize,
     next_landmark: LandmarkId,
@@ -97,6 +110,7 @@ impl<C: Calculus> Mapper<C> {
             history: Vec::new(),
             sketch: Sketch::default(),
             last_seen: LastSeen::default(),
+            sighted: Vec::new(),
             expired: 0,
             next_landmark: 0,
             sightings: Vec::new(),
@@ -307,6 +321,15 @@ impl<C: Calculus> Mapper<C> {
                 }
                 self.next_landmark = associated.next_landmark;
                 self.remember(record, &associated);
+                self.sighted.push(Sighted {
+                    station: record.index,
+                    bearings: associated
+                        .fused
+                        .iter()
+                        .map(|s| (s.landmark, view.bearings[s.position]))
+                        .collect(),
+                    frame: self.history.last().expect("remembered").1.clone(),
+                });
                 self.hold_back(record, associated, view);
             }
             Err(contradiction) => {

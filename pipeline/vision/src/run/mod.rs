@@ -1,6 +1,7 @@
 //! `pipeline run`: panoramas in, a qualitative map and its RNG out (000 §IV, §VI-C):
 //! [`detect_survey`], then [`map_stations`] with a [`Mapper`].
 
+pub mod beliefs;
 pub mod front_end;
 mod mapper;
 mod record;
@@ -8,8 +9,8 @@ pub(crate) mod selection;
 mod summary;
 mod traverse;
 
-pub use mapper::{LandmarkRecord, Mapper, StationDetections};
-pub use summary::RunSummary;
+pub use mapper::{LandmarkRecord, Mapper, Sighted, StationDetections};
+pub use summary::{BeliefsSummary, RunSummary};
 pub use traverse::{
     detect_survey, map_stations, Detected, Progress, Quiet, RunError, RunSettings, Stage, Traverse,
 };

@@ -57,6 +57,23 @@ pub struct RunSummary {
     /// every image) before any work.
     #[serde(default)]
     pub wall_checks: f64,
+    /// `--mode probabilistic`: how 002's beliefs (beliefs.json) were made.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beliefs: Option<BeliefsSummary>,
+}
+
+/// How the run's 002 beliefs were made (`super::beliefs`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BeliefsSummary {
+    /// `fast` or `full`.
+    pub estimator: String,
+    /// Triples fused together at two or more stations, and those of them that got a belief
+    /// (a chain of two or more views linked by a motion from the stereo placements).
+    pub triples_seen_twice: usize,
+    pub triples: usize,
+    /// The bearing s.d. assumed, degrees.
+    pub bearing_sd_deg: f64,
+    pub wall_seconds: f64,
 }
 
 impl RunSummary {
@@ -110,6 +127,7 @@ impl RunSummary {
             wall_mapping,
             wall_outputs: 0.0,
             wall_checks: 0.0,
+            beliefs: None,
         }
     }
 }
@@ -157,6 +175,13 @@ impl fmt::Display for RunSummary {
             self.expired_held_back,
             self.pending_held_back
         )?;
+        if let Some(b) = &self.beliefs {
+            writeln!(
+                f,
+                "002 beliefs ({} estimator, bearing s.d. {:.2}°): {} of the {} triples fused together at two or more stations, in {:.2} s",
+                b.estimator, b.bearing_sd_deg, b.triples, b.triples_seen_twice, b.wall_seconds
+            )?;
+        }
         write!(
             f,
             "time: checks {:.2} s | decode {:.2} s + detect {:.2} s (CPU, {:.2} s wall) | range {:.2} s, associate {:.2} s, map {:.2} s, metrics and RNG {:.2} s, recording {:.2} s ({:.2} s wall) | outputs {:.2} s",
