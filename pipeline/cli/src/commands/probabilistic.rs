@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use qrm_atomic_file::OutputSet;
 use qrm_core::probabilistic::study::{
-    quartiles, run_study, Accuracy, Outcome, Score, StudySettings,
+    calibration, quartiles, run_study, Accuracy, Outcome, Score, StudySettings,
 };
 use qrm_core::probabilistic::Noise;
 use qrm_plot::{write_panels, Curve, Panel};
@@ -150,6 +150,25 @@ pub fn run(args: &ProbabilisticArgs) -> Result<()> {
         let cell = |q: &[f64; 3]| format!("{:.2} {:.2} {:.2}", q[0], q[1], q[2]);
         println!("{name:<9} {:<34} {:<34} {:<34}", cell(d), cell(g), cell(e));
     }
+    println!(
+        "calibration of AB:C: beliefs by the probability of their most likely state (count, mean probability → how often it is the truth)"
+    );
+    let mut calibrations = Vec::new();
+    for (k, (name, _, _)) in PAPER.iter().enumerate() {
+        let bins = calibration(outcomes.iter().map(|o| &pick(k, o).landmark));
+        let cells: Vec<String> = bins
+            .iter()
+            .filter(|b| b.beliefs > 0)
+            .map(|b| {
+                format!(
+                    "[{:.1},{:.1}) {:>4}: {:.2} → {:.2}",
+                    b.from, b.to, b.beliefs, b.mean_top_probability, b.truth_first
+                )
+            })
+            .collect();
+        println!("{name:<9} {}", cells.join("   "));
+        calibrations.push(json!({"algorithm": name, "bins": bins}));
+    }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let mut outputs = OutputSet::new();
@@ -158,6 +177,7 @@ pub fn run(args: &ProbabilisticArgs) -> Result<()> {
         "version": 1,
         "settings": settings,
         "rows": rows,
+        "calibration": calibrations,
         "seconds": started.elapsed().as_secs_f64(),
     });
     stage_json(&mut outputs, &args.out.join("table1.json"), &table)?;

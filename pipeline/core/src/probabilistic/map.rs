@@ -136,16 +136,16 @@ pub fn beliefs(
                 return None;
             }
             let prior = disc_prior();
+            let noise = Noise {
+                bearing: bearing_sd,
+                motion: motion_sd,
+            };
             let estimate = match estimator.variant {
                 Variant::Full => {
-                    let noise = Noise {
-                        bearing: bearing_sd,
-                        motion: motion_sd,
-                    };
                     estimate_full(&views, &prior, noise, estimator.particles, &mut rng)
                 }
                 Variant::Fast => {
-                    estimate_fast(&views, &prior, bearing_sd, estimator.particles, &mut rng)
+                    estimate_fast(&views, &prior, noise, estimator.particles, &mut rng)
                 }
             }?;
             Some(TripleBelief {
@@ -374,7 +374,7 @@ mod tests {
         let estimator = Estimator {
             variant: Variant::Fast,
             views: 3,
-            particles: 400,
+            particles: 4000,
         };
         // Only the displacement from station 0 to station 2 is known.
         let motions = |from: usize, to: usize, _: &mut dyn RngCore| {

@@ -1,16 +1,17 @@
 //! Qualitative estimation of one triplet `A, B, C` from bearings seen at a few camera poses
 //! (002 §III; seed digest C.2–C.4, C.7), in the frame `A = (0,0)`, `B = (0,1)`.
 //!
-//! - [`estimate_full`]: the sampling algorithm (002 Algorithm 1). Each particle draws the
-//!   first pose on the inscribed-angle locus of a noisy subtended angle `γ' ~ N(γ, 2σ_v²)`,
-//!   each later pose where the ray of a noisy motion command meets that step's locus, then
-//!   resects `C` (the centroid of the pairwise intersections of its bearing rays) and is
-//!   weighted by the likelihood of `C`'s bearings. The belief is the weighted histogram of
-//!   `C`'s region (Eq. 9).
-//! - [`estimate_fast`]: 002 §III-D, "sampling only for the prior, noise neglected": the first
-//!   pose along the exact locus, later poses and `C` by exact intersection; particles are
-//!   still weighted by `C`'s bearings (without that, every pose on the first locus would count
-//!   alike and the belief would not be "very close to the full one", as 002 reports).
+//! - [`estimate_full`]: the sampling algorithm (002 Algorithm 1). Each particle draws each
+//!   view's bearings of `A` and `B` around the measured ones (their difference gives the
+//!   inscribed-angle locus, the bearing of `A` the heading), the first pose uniform on its
+//!   locus, each later pose where the ray of a noisy motion command meets that step's locus;
+//!   it then resects `C` (the centroid of the pairwise intersections of its bearing rays) and
+//!   is weighted by the likelihood of `C`'s bearings and by the area its poses' draw covers
+//!   (so that the particles stand for 002's uniform prior over positions). The belief is the
+//!   weighted histogram of `C`'s region (Eq. 9).
+//! - [`estimate_fast`]: 002 §III-D, measurement noise neglected: every pose on its exact
+//!   locus, weighted as the full one's; the motion command's noise is still drawn (see the
+//!   function).
 //! - [`estimate_baseline`]: 002 §III-F, after Padgett & Campbell: each view alone (pose on its
 //!   locus, `C` anywhere along its bearing ray within the prior's support), views multiplied
 //!   as if independent.
@@ -195,8 +196,28 @@ fn log_gaussian(x: f64, sd: f64) -> f64 {
     -0.5 * (x / sd.max(1e-9)).powi(2)
 }
 
+/// The size of the gradient of the subtended angle [`subtended`] at `x`: how fast the locus
+/// changes as the camera moves across it, `|(B − x)/|B − x|² − (A − x)/|A − x|²|`.
+fn subtended_gradient(x: Point) -> f64 {
+    let (da, db) = (x.distance(A).powi(2), x.distance(B).powi(2));
+    ((B.x - x.x) / db - (A.x - x.x) / da).hypot((B.y - x.y) / db - (A.y - x.y) / da)
+}
+
 /// One particle's path: poses from the locus of each view (sampled with `noise`, or exact),
-/// `C` resected, and the log-likelihood of `C`'s bearings at `bearing_sd`.
+/// `C` resected, and its log-weight: the likelihood of `C`'s bearings at `bearing_sd` and,
+/// with `noise`, the ratio of 002's prior (camera positions uniform in the plane) to the
+/// density at which the poses were drawn.
+///
+/// With `noise`, each view's bearings of `A` and `B` are drawn around the measured ones:
+/// their difference gives the locus, and the bearing of `A` the camera's heading. The first
+/// pose is uniform in the circle's parameter, a later one where a noisy motion ray meets its
+/// locus. Positions drawn that way are not uniform in the plane: the density of a pose is
+/// that of the noise in the angles that put it there, times the length those angles sweep,
+/// so each pose is weighted by the area its draw covers — the locus spacing
+/// `1 / |∇γ|` ([`subtended_gradient`]) times the circle's radius for the first pose, or the
+/// ray's reach per radian of heading (distance over the sine of the angle at which it crosses
+/// the locus) for a later one, times the number of crossings of which one was picked.
+/// Without these weights the particles crowd where the loci are dense, near `A` and `B`.
 fn particle(
     views: &[View],
     prior: &Prior,
@@ -204,32 +225,19 @@ fn particle(
     bearing_sd: f64,
     rng: &mut impl Rng,
 ) -> Option<Particle> {
-    let jitter = |sd: f64, rng: &mut dyn rand::RngCore| match noise {
-        Some(_) if sd > 0.0 => Normal::new(0.0, sd).expect("finite s.d.").sample(rng),
-        _ => 0.0,
-    };
-    let sd_gamma = noise.map_or(0.0, |n| n.bearing * 2f64.sqrt());
-    let sd_motion = noise.map_or(0.0, |n| n.motion);
     let mut poses: Vec<(Point, f64)> = Vec::with_capacity(views.len());
-    for (k, view) in views.iter().enumerate() {
-        let gamma = wrap(view.bearings[1] - view.bearings[0]) + jitter(sd_gamma, rng);
-        let x = if k == 0 {
-            // A uniform circle parameter; off-arc draws are redrawn a few times.
-            (0..32).find_map(|_| locus_point(gamma, rng.random::<f64>() * TAU))?
-        } else {
-            let (previous, alpha) = poses[k - 1];
-            let psi = view.motion? + jitter(sd_motion, rng);
-            let hits = ray_meets_locus(previous, direction(alpha + psi), gamma);
-            *hits.get(rng.random_range(0..hits.len().max(1)))?
-        };
+    let mut log_area = 0.0;
+    for view in views {
+        let (x, alpha, area) = draw_pose(view, poses.last().copied(), noise, rng)?;
         if !prior.contains(x) {
             return None;
         }
-        poses.push((x, heading(x, view.bearings[0])));
+        log_area += area;
+        poses.push((x, alpha));
     }
     let phi_c: Vec<f64> = views.iter().map(|v| v.bearings[2]).collect();
     let c = resect(&poses, &phi_c).filter(|&c| prior.contains(c))?;
-    let log_weight = poses
+    let likelihood: f64 = poses
         .iter()
         .zip(&phi_c)
         .map(|(&(x, alpha), &phi)| log_gaussian(wrap(angle_to(x, c) - alpha - phi), bearing_sd))
@@ -237,8 +245,48 @@ fn particle(
     Some(Particle {
         c,
         cameras: poses.iter().map(|p| p.0).collect(),
-        log_weight,
+        log_weight: likelihood + log_area,
     })
+}
+
+/// One pose of [`particle`]: the camera position and heading for `view`, after `previous`
+/// (none for the first view), and the log of the area its draw covers.
+fn draw_pose(
+    view: &View,
+    previous: Option<(Point, f64)>,
+    noise: Option<Noise>,
+    rng: &mut impl Rng,
+) -> Option<(Point, f64, f64)> {
+    let mut jitter = |sd: f64| match noise {
+        Some(_) if sd > 0.0 => Normal::new(0.0, sd).expect("finite s.d.").sample(rng),
+        _ => 0.0,
+    };
+    let (sd_bearing, sd_motion) = noise.map_or((0.0, 0.0), |n| (n.bearing, n.motion));
+    let phi_a = view.bearings[0] + jitter(sd_bearing);
+    let phi_b = view.bearings[1] + jitter(sd_bearing);
+    let motion = view.motion.map(|psi| psi + jitter(sd_motion));
+    let gamma = wrap(phi_b - phi_a);
+    let (centre, radius) = locus_circle(gamma)?;
+    let (x, reach) = match previous {
+        // Uniform along the locus arc (off-arc draws are redrawn a few times), whose length
+        // is the radius times its central angle, 2(π − |γ|).
+        None => (
+            (0..32).find_map(|_| locus_point(gamma, rng.random::<f64>() * TAU))?,
+            radius * 2.0 * (PI - gamma.abs()),
+        ),
+        Some((previous, alpha)) => {
+            let dir = direction(alpha + motion?);
+            let hits = ray_meets_locus(previous, dir, gamma);
+            let x = *hits.get(rng.random_range(0..hits.len().max(1)))?;
+            let crossing = ((x.x - centre.x) * dir.x + (x.y - centre.y) * dir.y).abs() / radius;
+            (
+                x,
+                previous.distance(x) / crossing.max(1e-9) * hits.len() as f64,
+            )
+        }
+    };
+    let log_area = (reach / subtended_gradient(x).max(1e-12)).ln();
+    Some((x, heading(x, phi_a), log_area))
 }
 
 /// Adds `weight` to the region of `p` (nothing on a boundary).
@@ -289,17 +337,25 @@ pub fn estimate_full(
     histogram(&samples, views.len())
 }
 
-/// 002 §III-D: the prior sampled along the exact first locus, everything else exact, the
-/// particles weighted by `C`'s bearings at `bearing_sd`.
+/// 002 §III-D: measurement noise neglected — every pose on its exact locus, `C` resected
+/// from the exact bearings — the particles weighted by the area of their draw and by `C`'s
+/// bearings at `noise.bearing`. The motion command's noise is still drawn (`noise.motion`):
+/// 002 neglects it too, but an exact motion ray misses the next locus in 16 % of Table I's
+/// triplets (σ_w = 7°), which then get no belief at all, and at every noise level tried the
+/// estimate is closer to the full one with it drawn (docs/PROBABILISTIC.md).
 pub fn estimate_fast(
     views: &[View],
     prior: &Prior,
-    bearing_sd: f64,
+    noise: Noise,
     particles: usize,
     rng: &mut impl Rng,
 ) -> Option<Estimate> {
+    let exact_loci = Noise {
+        bearing: 0.0,
+        motion: noise.motion,
+    };
     let samples: Vec<Particle> = (0..particles)
-        .filter_map(|_| particle(views, prior, None, bearing_sd, rng))
+        .filter_map(|_| particle(views, prior, Some(exact_loci), noise.bearing, rng))
         .collect();
     histogram(&samples, views.len())
 }
@@ -332,10 +388,11 @@ pub fn estimate_baseline(
             if let Some((t0, t1)) = prior.clip(x, dir) {
                 let t = t0 + rng.random::<f64>() * (t1 - t0);
                 let c = Point::new(x.x + t * dir.x, x.y + t * dir.y);
-                // Weighted by the ray's length inside the prior: uniform over the region the
-                // view allows.
-                add(&mut weights, c, t1 - t0);
-                add(&mut camera, x, t1 - t0);
+                // Weighted by the ray's length inside the prior and the locus spacing at the
+                // pose: uniform over the region the view allows.
+                let w = (t1 - t0) / subtended_gradient(x).max(1e-12);
+                add(&mut weights, c, w);
+                add(&mut camera, x, w);
             }
         }
         cameras.push(Belief::from_weights(camera).unwrap_or_else(Belief::uniform));
@@ -387,6 +444,67 @@ mod tests {
         assert!(hits.iter().any(|h| h.distance(x) < 1e-9), "{hits:?}");
     }
 
+    /// The first pose of a noisy view, weighted by the area of its draw, follows the posterior
+    /// of a camera uniform in a disc, `∝ N(γ(X); γ_measured, 2σ²)`, integrated independently
+    /// on a grid; unweighted, it does not.
+    #[test]
+    fn weighted_first_poses_follow_the_posterior_of_a_uniform_camera() {
+        let sigma = 3f64.to_radians();
+        let camera = Point::new(1.8, -1.1);
+        let view = View {
+            bearings: [angle_to(camera, A) - 0.4, angle_to(camera, B) - 0.4, 0.0],
+            motion: None,
+        };
+        let gamma = wrap(view.bearings[1] - view.bearings[0]);
+        let radius = 4.0;
+        let inside = |x: Point| x.distance(Point::new(0.0, 0.5)) < radius;
+        let near_a = |x: Point| x.distance(A) < 1.5;
+        // The grid: the posterior's mass near A, as a fraction of its mass in the disc.
+        let (mut near, mut all) = (0.0, 0.0);
+        let step = 0.01;
+        for i in 0..(2.0 * radius / step) as usize {
+            for j in 0..(2.0 * radius / step) as usize {
+                let x = Point::new(
+                    -radius + (i as f64 + 0.5) * step,
+                    0.5 - radius + (j as f64 + 0.5) * step,
+                );
+                if inside(x) {
+                    let w = log_gaussian(wrap(subtended(x) - gamma), sigma * 2f64.sqrt()).exp();
+                    all += w;
+                    near += if near_a(x) { w } else { 0.0 };
+                }
+            }
+        }
+        let grid = near / all;
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let noise = Some(Noise {
+            bearing: sigma,
+            motion: 0.0,
+        });
+        let (mut weighted, mut unweighted) = ([0.0; 2], [0.0; 2]);
+        for _ in 0..200_000 {
+            let Some((x, _, log_area)) = draw_pose(&view, None, noise, &mut rng) else {
+                continue;
+            };
+            if inside(x) {
+                let k = usize::from(near_a(x));
+                weighted[k] += log_area.exp();
+                unweighted[k] += 1.0;
+            }
+        }
+        let share = |w: [f64; 2]| w[1] / (w[0] + w[1]);
+        assert!(
+            (share(weighted) - grid).abs() < 0.02,
+            "weighted {} against the grid's {grid}",
+            share(weighted)
+        );
+        assert!(
+            (share(unweighted) - grid).abs() > 0.05,
+            "unweighted {} against the grid's {grid}",
+            share(unweighted)
+        );
+    }
+
     #[test]
     fn exact_views_put_the_truth_first() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
@@ -406,7 +524,11 @@ mod tests {
                 Point::new(-6.0, 6.0),
             ],
         };
-        let fast = estimate_fast(&v, &prior, 0.5f64.to_radians(), 500, &mut rng).unwrap();
+        let noise = Noise {
+            bearing: 0.5f64.to_radians(),
+            motion: 1f64.to_radians(),
+        };
+        let fast = estimate_fast(&v, &prior, noise, 500, &mut rng).unwrap();
         assert_eq!(fast.landmark.most_likely(), truth);
         // Eq. (10): every camera's own region comes first too.
         for (belief, &(x, _)) in fast.cameras.iter().zip(&poses) {
