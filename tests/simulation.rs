@@ -50,6 +50,7 @@ fn noisy_bearings_within_the_declared_interval_are_sound() {
         bearing_noise: 0.01,
         bearing_uncertainty: 0.01,
         order_swap_probability: 0.0,
+        wrong_association_probability: 0.0,
     };
     sound_runs::<Edc>(sensor, 20..24);
 }

@@ -63,17 +63,30 @@ pub struct SensorArgs {
     /// rejected panoramas are counted as contradictions).
     #[arg(long, default_value_t = 0.0)]
     order_swaps: f64,
+    /// Probability that a sighting is reported as another landmark, one not seen at that
+    /// imaging point (association errors: a look-alike from elsewhere in the field).
+    #[arg(long, default_value_t = 0.0)]
+    wrong_associations: f64,
 }
 
 impl SensorArgs {
     fn sensor(&self, nearest: Option<usize>) -> Result<Sensor> {
-        sensor(self.bearing_noise, self.order_swaps, nearest)
+        if !(0.0..=1.0).contains(&self.wrong_associations) {
+            bail!(
+                "--wrong-associations {} must be a probability",
+                self.wrong_associations
+            );
+        }
+        Ok(Sensor {
+            wrong_association_probability: self.wrong_associations,
+            ..sensor(self.bearing_noise, self.order_swaps, nearest)?
+        })
     }
 }
 
 /// The simulated sensor: bearing errors uniform within ±`bearing_noise` degrees (and the
 /// measurement told so), each adjacent pair of the range order swapped with probability
-/// `order_swaps`, the `nearest` landmarks seen (all: `None`).
+/// `order_swaps`, the `nearest` landmarks seen (all: `None`), no association errors.
 pub fn sensor(bearing_noise: f64, order_swaps: f64, nearest: Option<usize>) -> Result<Sensor> {
     if nearest.is_some_and(|n| n < 3) {
         bail!("--nearest must be at least 3 (a triple)");
@@ -93,6 +106,7 @@ pub fn sensor(bearing_noise: f64, order_swaps: f64, nearest: Option<usize>) -> R
         bearing_noise: bearing_noise.to_radians(),
         bearing_uncertainty: bearing_noise.to_radians(),
         order_swap_probability: order_swaps,
+        wrong_association_probability: 0.0,
     })
 }
 
