@@ -105,7 +105,12 @@ pub fn register(
         .copied()
         .filter(|&(i, j)| seed(i, frame.landmarks[j].0))
         .collect();
-    let hypotheses = hypotheses(current, frame, &seeds, &correspondences);
+    let hypotheses = hypotheses(
+        current,
+        frame,
+        &seeds,
+        &Candidates::new(current, frame, &correspondences),
+    );
     let inliers = decisive(&hypotheses).or_else(|| {
         let chance = chance(frame, &seeds, &correspondences);
         significant(current, frame, &hypotheses, &chance)
@@ -132,7 +137,7 @@ fn hypotheses(
     current: &[Option<Placed>],
     frame: &Frame,
     seeds: &[(usize, usize)],
-    correspondences: &[(usize, usize)],
+    candidates: &Candidates,
 ) -> Vec<Hypothesis> {
     let mut out = Vec::new();
     for (x, &(i1, j1)) in seeds.iter().enumerate() {
@@ -152,7 +157,7 @@ fn hypotheses(
                 continue;
             }
             let motion = Motion::from_pairs([p1.point, p2.point], [q1.point, q2.point]);
-            let (inliers, score) = matches(current, frame, &motion, correspondences);
+            let (inliers, score) = matches(candidates, &motion);
             out.push(Hypothesis { inliers, score });
         }
     }
@@ -575,32 +580,72 @@ impl Motion {
     }
 }
 
+/// The look-alike correspondences of one registration as a table of placed detections by the
+/// frame's landmarks: scoring a motion hypothesis ([`matches`]) is then a tight loop. A
+/// registration tries hundreds of hypotheses against a few hundred correspondences each;
+/// against every station of a run (`navigate`'s localization) that was most of a step.
+struct Candidates {
+    /// Detections with a placement and a look-alike in the frame: index and placement.
+    detections: Vec<(usize, Placed)>,
+    /// The frame's landmarks: coordinates and radii.
+    x: Vec<f64>,
+    y: Vec<f64>,
+    radius: Vec<f64>,
+    /// `alike[k × landmarks + j]`: detection `detections[k]` may be landmark `j`.
+    alike: Vec<bool>,
+}
+
+impl Candidates {
+    /// The table of `correspondences`, `(detection, index into the frame's landmarks)`.
+    fn new(
+        current: &[Option<Placed>],
+        frame: &Frame,
+        correspondences: &[(usize, usize)],
+    ) -> Candidates {
+        let n = frame.landmarks.len();
+        let mut detections: Vec<(usize, Placed)> = Vec::new();
+        let mut alike: Vec<bool> = Vec::new();
+        for &(i, j) in correspondences {
+            if detections.last().is_none_or(|&(k, _)| k != i) {
+                detections.push((i, current[i].expect("correspondences are placed")));
+                alike.resize(alike.len() + n, false);
+            }
+            let row = detections.len() - 1;
+            alike[row * n + j] = true;
+        }
+        Candidates {
+            detections,
+            x: frame.landmarks.iter().map(|(_, q)| q.point[0]).collect(),
+            y: frame.landmarks.iter().map(|(_, q)| q.point[1]).collect(),
+            radius: frame.landmarks.iter().map(|(_, q)| q.radius).collect(),
+            alike,
+        }
+    }
+}
+
 /// The one-to-one correspondences (nearest first) that `motion` brings within tolerance, and
 /// the fit score Σ (1 − (d / tolerance)²).
-fn matches(
-    current: &[Option<Placed>],
-    frame: &Frame,
-    motion: &Motion,
-    correspondences: &[(usize, usize)],
-) -> (Vec<(usize, usize)>, f64) {
-    let mut close: Vec<(f64, usize, usize, f64)> = correspondences
-        .iter()
-        .filter_map(|&(i, j)| {
-            let p = current[i].expect("filtered");
-            let q = frame.landmarks[j].1;
-            let moved = motion.apply(p.point);
-            let (dx, dy) = (moved[0] - q.point[0], moved[1] - q.point[1]);
-            let tolerance = p.radius + q.radius + SLACK_M;
-            // Most correspondences are far off: a squared test rejects them without `hypot`
-            // (libm's exact one), which took 40 % of a closed-loop drive's CPU here. The margin
-            // keeps every pair the exact test keeps.
+fn matches(candidates: &Candidates, motion: &Motion) -> (Vec<(usize, usize)>, f64) {
+    let n = candidates.x.len();
+    let mut close: Vec<(f64, usize, usize, f64)> = Vec::new();
+    for (row, &(i, p)) in candidates.detections.iter().enumerate() {
+        let [mx, my] = motion.apply(p.point);
+        let alike = &candidates.alike[row * n..(row + 1) * n];
+        for j in (0..n).filter(|&j| alike[j]) {
+            let (dx, dy) = (mx - candidates.x[j], my - candidates.y[j]);
+            let tolerance = p.radius + candidates.radius[j] + SLACK_M;
+            // A squared test first: libm's exact `hypot` is slow, and most pairs are far off.
+            // The margin keeps every pair the exact test keeps.
             if dx * dx + dy * dy > tolerance * tolerance * (1.0 + 1e-9) {
-                return None;
+                continue;
             }
             let d = dx.hypot(dy);
-            (d <= tolerance).then_some((d, i, j, 1.0 - (d / tolerance).powi(2)))
-        })
-        .collect();
+            if d <= tolerance {
+                close.push((d, i, j, 1.0 - (d / tolerance).powi(2)));
+            }
+        }
+    }
+    // Stable: ties stay in (detection, landmark) order.
     close.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut used_i = Vec::new();
     let mut used_j = Vec::new();
@@ -843,7 +888,13 @@ pub(super) mod tests {
         let all: Vec<(usize, usize)> = (0..current.len())
             .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
             .collect();
-        assert!(decisive(&hypotheses(&current, &frame, &all, &all)).is_none());
+        assert!(decisive(&hypotheses(
+            &current,
+            &frame,
+            &all,
+            &Candidates::new(&current, &frame, &all)
+        ))
+        .is_none());
         let registration = register(&current, &frame, &alike, &alike).expect("registers");
         let mut pairs = registration.pairs;
         pairs.sort_unstable();
@@ -859,9 +910,14 @@ pub(super) mod tests {
             .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
             .collect();
         let truth = [(0, 0), (1, 1), (2, 2), (3, 3)];
-        assert!(hypotheses(&current, &frame, &all, &all)
-            .iter()
-            .any(|h| h.inliers.len() >= MIN_INLIERS && same_assignment(&h.inliers, &truth)));
+        assert!(hypotheses(
+            &current,
+            &frame,
+            &all,
+            &Candidates::new(&current, &frame, &all)
+        )
+        .iter()
+        .any(|h| h.inliers.len() >= MIN_INLIERS && same_assignment(&h.inliers, &truth)));
         let alike = |_: usize, _: LandmarkId| true;
         assert_eq!(register(&current, &frame, &alike, &alike), None);
     }
