@@ -1577,6 +1577,21 @@ fn directions_cases() -> Vec<Case> {
             &["--motion-noise"],
         ),
         Case::new(
+            "simulate single: the beliefs' options without --mode probabilistic",
+            "simulate single --motion-noise 3 --out {dir}/s",
+            &["--motion-noise", "--mode probabilistic"],
+        ),
+        Case::new(
+            "simulate single: an estimator without --mode probabilistic",
+            "simulate single --estimator full --out {dir}/s",
+            &["--estimator", "--mode probabilistic"],
+        ),
+        Case::new(
+            "simulate single: wrong associations not a probability",
+            "simulate single --wrong-associations 1.5 --out {dir}/s",
+            &["--wrong-associations"],
+        ),
+        Case::new(
             "simulate directions: no trials",
             "simulate directions --trials 0 --out {dir}/study",
             &["--trials and --routes must be positive"],

@@ -205,6 +205,23 @@ fn maps_the_demo_with_beliefs() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("--views"), "{}", stderr(&o));
     assert!(!bad.join("out").exists(), "nothing is written");
+    // The estimator's options without the mode are refused, not ignored.
+    let o = pipeline(&[
+        "run",
+        "--images",
+        arg(&images),
+        "--out",
+        arg(&bad.join("out")),
+        "--estimator",
+        "full",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--mode probabilistic"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!bad.join("out").exists(), "nothing is written");
 }
 
 /// The (width, height) of the PNG at `path`, from its header.

@@ -281,7 +281,7 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
         );
     }
     let calib = load_calibration(args)?;
-    let estimator = args.beliefs.estimator()?;
+    let estimator = args.beliefs.estimator(args.mode)?;
     // The truth, given or found in the image directory, is read before any work: a bad one
     // would otherwise fail only once the run's outputs had replaced the earlier ones. A given
     // one must also describe every image (a found one is checked image by image when scoring,

@@ -176,23 +176,24 @@ pub struct BeliefArgs {
     #[command(flatten)]
     estimator: EstimatorArgs,
     /// Noise of 002's motion command (heading of the displacement between two views, which
-    /// the deterministic map does not use), s.d. in degrees.
-    #[arg(long, default_value_t = 2.0)]
-    motion_noise: f64,
+    /// the deterministic map does not use), s.d. in degrees (default 2).
+    #[arg(long)]
+    motion_noise: Option<f64>,
 }
 
-/// Which of 002's estimators makes the beliefs of `--mode probabilistic`, and how.
+/// Which of 002's estimators makes the beliefs of `--mode probabilistic`, and how. Given
+/// without that mode, they are refused rather than ignored.
 #[derive(Args, Debug)]
 pub struct EstimatorArgs {
-    /// 002's estimator: `fast` (§III-D) or `full` (Algorithm 1).
-    #[arg(long, value_enum, default_value = "fast")]
-    estimator: EstimatorName,
-    /// Views per triple: the first stations that see it (002: 3 time steps).
-    #[arg(long, default_value_t = 3)]
-    views: usize,
-    /// Particles per triple.
-    #[arg(long, default_value_t = 300)]
-    particles: usize,
+    /// 002's estimator: `fast` (§III-D, the default) or `full` (Algorithm 1).
+    #[arg(long, value_enum)]
+    estimator: Option<EstimatorName>,
+    /// Views per triple: the first stations that see it (002: 3 time steps; the default).
+    #[arg(long)]
+    views: Option<usize>,
+    /// Particles per triple (default 300).
+    #[arg(long)]
+    particles: Option<usize>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -202,35 +203,45 @@ pub enum EstimatorName {
 }
 
 impl EstimatorArgs {
-    pub(super) fn estimator(&self) -> Result<Estimator> {
-        if self.views < 2 {
+    /// The estimator these options choose, for `mode`; an error if they were given for the
+    /// deterministic mode, which makes no beliefs.
+    pub(super) fn estimator(&self, mode: Mode) -> Result<Estimator> {
+        let given = self.estimator.is_some() || self.views.is_some() || self.particles.is_some();
+        if mode == Mode::Deterministic && given {
+            bail!("--estimator, --views and --particles shape 002's beliefs: give them with --mode probabilistic");
+        }
+        let views = self.views.unwrap_or(3);
+        let particles = self.particles.unwrap_or(300);
+        if views < 2 {
             bail!("--views must be at least 2: 002 resects C from two views or more");
         }
-        if self.particles == 0 {
+        if particles == 0 {
             bail!("--particles must be positive");
         }
         Ok(Estimator {
-            variant: match self.estimator {
+            variant: match self.estimator.unwrap_or(EstimatorName::Fast) {
                 EstimatorName::Fast => Variant::Fast,
                 EstimatorName::Full => Variant::Full,
             },
-            views: self.views,
-            particles: self.particles,
+            views,
+            particles,
         })
     }
 }
 
 impl BeliefArgs {
-    fn settings(&self) -> Result<BeliefSettings> {
-        if !(0.0..=60.0).contains(&self.motion_noise) {
-            bail!(
-                "--motion-noise {} must lie in [0, 60] degrees",
-                self.motion_noise
-            );
+    /// The simulator's belief settings for `mode` (refused if given for the deterministic one).
+    fn settings(&self, mode: Mode) -> Result<BeliefSettings> {
+        if mode == Mode::Deterministic && self.motion_noise.is_some() {
+            bail!("--motion-noise is the noise of 002's motion command: give it with --mode probabilistic");
+        }
+        let motion_noise = self.motion_noise.unwrap_or(2.0);
+        if !(0.0..=60.0).contains(&motion_noise) {
+            bail!("--motion-noise {motion_noise} must lie in [0, 60] degrees");
         }
         Ok(BeliefSettings {
-            estimator: self.estimator.estimator()?,
-            motion_noise: self.motion_noise.to_radians(),
+            estimator: self.estimator.estimator(mode)?,
+            motion_noise: motion_noise.to_radians(),
         })
     }
 }
@@ -248,18 +259,20 @@ pub fn run_command(command: SimulateCommand) -> Result<()> {
         SimulateCommand::Montecarlo(args) => montecarlo(args),
         SimulateCommand::Directions(args) => super::directions::study(&args),
         SimulateCommand::Probabilistic(args) => super::probabilistic::run(&args),
-        SimulateCommand::Single(args) => match (args.calculus, args.mode) {
-            (CalculusName::Edc, Mode::Probabilistic) => {
-                let settings = args.beliefs.settings()?;
-                let simulated = single::<Edc>(&args)?;
-                probabilistic_single(&args, &settings, &simulated)
+        SimulateCommand::Single(args) => {
+            let settings = args.beliefs.settings(args.mode)?;
+            match (args.calculus, args.mode) {
+                (CalculusName::Edc, Mode::Probabilistic) => {
+                    let simulated = single::<Edc>(&args)?;
+                    probabilistic_single(&args, &settings, &simulated)
+                }
+                (CalculusName::Fdc, Mode::Probabilistic) => bail!(
+                    "--mode probabilistic needs --calculus edc: 002's beliefs are over the 20 EDC states"
+                ),
+                (CalculusName::Edc, Mode::Deterministic) => single::<Edc>(&args).map(drop),
+                (CalculusName::Fdc, Mode::Deterministic) => single::<Fdc>(&args).map(drop),
             }
-            (CalculusName::Fdc, Mode::Probabilistic) => bail!(
-                "--mode probabilistic needs --calculus edc: 002's beliefs are over the 20 EDC states"
-            ),
-            (CalculusName::Edc, Mode::Deterministic) => single::<Edc>(&args).map(drop),
-            (CalculusName::Fdc, Mode::Deterministic) => single::<Fdc>(&args).map(drop),
-        },
+        }
         SimulateCommand::Basic(args) => match args.calculus {
             CalculusName::Edc => basic::<Edc>(args.seed),
             CalculusName::Fdc => basic::<Fdc>(args.seed),
@@ -600,13 +613,13 @@ fn probabilistic_single(
     )?;
     let pct = |n: usize| 100.0 * n as f64 / c.triples.max(1) as f64;
     println!(
-        "002 beliefs ({} estimator, ≤ {} views, motion noise {}°) for {} triples seen from two or more points, in {elapsed:.2} s:",
+        "002 beliefs ({} estimator, ≤ {} views, motion noise {:.1}°) for {} triples seen from two or more points, in {elapsed:.2} s:",
         match settings.estimator.variant {
             Variant::Fast => "fast",
             Variant::Full => "full",
         },
         settings.estimator.views,
-        args.beliefs.motion_noise,
+        settings.motion_noise.to_degrees(),
         c.triples
     );
     println!(
