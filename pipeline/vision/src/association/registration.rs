@@ -596,7 +596,8 @@ struct Candidates {
 }
 
 impl Candidates {
-    /// The table of `correspondences`, `(detection, index into the frame's landmarks)`.
+    /// The table of `correspondences`, `(detection, index into the frame's landmarks)`,
+    /// grouped by detection as [`register`] lists them.
     fn new(
         current: &[Option<Placed>],
         frame: &Frame,
@@ -734,6 +735,70 @@ pub(super) mod tests {
         let mut few = seen_from(at, 1.0, 0.0);
         few.landmarks.truncate(MIN_INLIERS - 1);
         assert!(displacement(&earlier, &few).is_none());
+    }
+
+    /// The table-driven [`matches`] keeps exactly the pairs, in the order, that testing every
+    /// correspondence with the exact distance keeps: many placements (from a fixed
+    /// pseudo-random sequence), some look-alikes, motions of every size.
+    #[test]
+    fn matches_from_the_table_are_those_of_every_correspondence_tested() {
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut place = |spread: f64| Placed {
+            point: [spread * (next() - 0.5), spread * (next() - 0.5)],
+            radius: 0.1 + next(),
+        };
+        let frame = Frame {
+            accumulated: false,
+            landmarks: (0..20).map(|k| (k as LandmarkId, place(12.0))).collect(),
+        };
+        let current: Vec<Option<Placed>> =
+            (0..30).map(|i| (i % 7 != 3).then(|| place(12.0))).collect();
+        let correspondences: Vec<(usize, usize)> = (0..current.len())
+            .filter(|&i| current[i].is_some())
+            .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
+            .filter(|&(i, j)| (i + 2 * j) % 3 != 0)
+            .collect();
+        let candidates = Candidates::new(&current, &frame, &correspondences);
+        let reference = |motion: &Motion| {
+            let mut close: Vec<(f64, usize, usize)> = correspondences
+                .iter()
+                .filter_map(|&(i, j)| {
+                    let (p, q) = (current[i].unwrap(), frame.landmarks[j].1);
+                    let d = distance(motion.apply(p.point), q.point);
+                    (d <= p.radius + q.radius + SLACK_M).then_some((d, i, j))
+                })
+                .collect();
+            close.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let (mut used_i, mut used_j, mut out) = (Vec::new(), Vec::new(), Vec::new());
+            for (_, i, j) in close {
+                if !used_i.contains(&i) && !used_j.contains(&j) {
+                    used_i.push(i);
+                    used_j.push(j);
+                    out.push((i, j));
+                }
+            }
+            out
+        };
+        let mut paired = 0;
+        for k in 0..50 {
+            let angle = 0.4 * k as f64;
+            let motion = Motion {
+                cos: angle.cos(),
+                sin: angle.sin(),
+                shift: [0.3 * (k % 5) as f64, -0.2 * (k % 3) as f64],
+            };
+            let (pairs, score) = matches(&candidates, &motion);
+            assert_eq!(pairs, reference(&motion), "motion {k}");
+            assert!(score >= 0.0 && score <= pairs.len() as f64);
+            paired += pairs.len();
+        }
+        assert!(paired > 200, "{paired} pairs: the comparison is not empty");
     }
 
     #[test]
