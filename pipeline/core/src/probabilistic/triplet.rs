@@ -203,25 +203,25 @@ fn subtended_gradient(x: Point) -> f64 {
     ((B.x - x.x) / db - (A.x - x.x) / da).hypot((B.y - x.y) / db - (A.y - x.y) / da)
 }
 
-/// One particle's path: poses from the locus of each view (sampled with `noise`, or exact),
-/// `C` resected, and its log-weight: the likelihood of `C`'s bearings at `bearing_sd` and,
-/// with `noise`, the ratio of 002's prior (camera positions uniform in the plane) to the
-/// density at which the poses were drawn.
+/// One particle's path: a pose on the locus of each view, drawn with `noise` (an s.d. of 0
+/// draws the measured angle itself), `C` resected, and its log-weight: the likelihood of
+/// `C`'s bearings at `bearing_sd` and the ratio of 002's prior (camera positions uniform in
+/// the plane) to the density at which the poses were drawn.
 ///
-/// With `noise`, each view's bearings of `A` and `B` are drawn around the measured ones:
-/// their difference gives the locus, and the bearing of `A` the camera's heading. The first
-/// pose is uniform in the circle's parameter, a later one where a noisy motion ray meets its
-/// locus. Positions drawn that way are not uniform in the plane: the density of a pose is
-/// that of the noise in the angles that put it there, times the length those angles sweep,
-/// so each pose is weighted by the area its draw covers — the locus spacing
-/// `1 / |∇γ|` ([`subtended_gradient`]) times the circle's radius for the first pose, or the
-/// ray's reach per radian of heading (distance over the sine of the angle at which it crosses
-/// the locus) for a later one, times the number of crossings of which one was picked.
-/// Without these weights the particles crowd where the loci are dense, near `A` and `B`.
+/// Each view's bearings of `A` and `B` are drawn around the measured ones: their difference
+/// gives the locus, and the bearing of `A` the camera's heading. The first pose is uniform
+/// along its locus arc, a later one where a noisy motion ray meets its locus. Positions drawn
+/// that way are not uniform in the plane: the density of a pose is that of the angles that
+/// put it there, times the area those angles sweep, so each pose is weighted by that area —
+/// the locus spacing `1 / |∇γ|` ([`subtended_gradient`]) times the arc's length for the first
+/// pose, or the ray's reach per radian of heading (distance over the sine of the angle at
+/// which it crosses the locus) for a later one, times the number of crossings of which one
+/// was picked. Without these weights the particles crowd where the loci are dense, near `A`
+/// and `B`.
 fn particle(
     views: &[View],
     prior: &Prior,
-    noise: Option<Noise>,
+    noise: Noise,
     bearing_sd: f64,
     rng: &mut impl Rng,
 ) -> Option<Particle> {
@@ -254,17 +254,19 @@ fn particle(
 fn draw_pose(
     view: &View,
     previous: Option<(Point, f64)>,
-    noise: Option<Noise>,
+    noise: Noise,
     rng: &mut impl Rng,
 ) -> Option<(Point, f64, f64)> {
-    let mut jitter = |sd: f64| match noise {
-        Some(_) if sd > 0.0 => Normal::new(0.0, sd).expect("finite s.d.").sample(rng),
-        _ => 0.0,
+    let mut jitter = |sd: f64| {
+        if sd > 0.0 {
+            Normal::new(0.0, sd).expect("finite s.d.").sample(rng)
+        } else {
+            0.0
+        }
     };
-    let (sd_bearing, sd_motion) = noise.map_or((0.0, 0.0), |n| (n.bearing, n.motion));
-    let phi_a = view.bearings[0] + jitter(sd_bearing);
-    let phi_b = view.bearings[1] + jitter(sd_bearing);
-    let motion = view.motion.map(|psi| psi + jitter(sd_motion));
+    let phi_a = view.bearings[0] + jitter(noise.bearing);
+    let phi_b = view.bearings[1] + jitter(noise.bearing);
+    let motion = view.motion.map(|psi| psi + jitter(noise.motion));
     let gamma = wrap(phi_b - phi_a);
     let (centre, radius) = locus_circle(gamma)?;
     let (x, reach) = match previous {
@@ -332,7 +334,7 @@ pub fn estimate_full(
     rng: &mut impl Rng,
 ) -> Option<Estimate> {
     let samples: Vec<Particle> = (0..particles)
-        .filter_map(|_| particle(views, prior, Some(noise), noise.bearing, rng))
+        .filter_map(|_| particle(views, prior, noise, noise.bearing, rng))
         .collect();
     histogram(&samples, views.len())
 }
@@ -355,7 +357,7 @@ pub fn estimate_fast(
         motion: noise.motion,
     };
     let samples: Vec<Particle> = (0..particles)
-        .filter_map(|_| particle(views, prior, Some(exact_loci), noise.bearing, rng))
+        .filter_map(|_| particle(views, prior, exact_loci, noise.bearing, rng))
         .collect();
     histogram(&samples, views.len())
 }
@@ -477,10 +479,10 @@ mod tests {
         }
         let grid = near / all;
         let mut rng = ChaCha8Rng::seed_from_u64(4);
-        let noise = Some(Noise {
+        let noise = Noise {
             bearing: sigma,
             motion: 0.0,
-        });
+        };
         let (mut weighted, mut unweighted) = ([0.0; 2], [0.0; 2]);
         for _ in 0..200_000 {
             let Some((x, _, log_area)) = draw_pose(&view, None, noise, &mut rng) else {
