@@ -75,14 +75,12 @@ pub struct Mapper<C: Calculus> {
     sensor: SensorModel,
     association: AssociationSettings,
     held: Vec<HeldBack>,
-    /// The fused landmarks of the stations within the sketch's window, placed around each
-    /// station, with the station's index.
-    history: Vec<(usize, Frame)>,
     /// The recently seen landmarks placed in one coordinate system.
     sketch: Sketch,
     /// When each landmark was last fused.
     last_seen: LastSeen,
-    /// Every station that fused landmarks, for 002's beliefs (`super::beliefs`).
+    /// Every station that fused landmarks, in order: the recent ones' frames are registered
+    /// against ([`Mapper::recent`]), all of them make 002's beliefs (`super::beliefs`).
     pub sighted: Vec<Sighted>,
     /// Held-back observations given up after [`HOLD_STATIONS`].
     pub expired: usize,
@@ -107,7 +105,6 @@ impl<C: Calculus> Mapper<C> {
             sensor,
             association,
             held: Vec::new(),
-            history: Vec::new(),
             sketch: Sketch::default(),
             last_seen: LastSeen::default(),
             sighted: Vec::new(),
@@ -194,17 +191,11 @@ impl<C: Calculus> Mapper<C> {
 
         let start = Instant::now();
         let evidence = selection::station_evidence(station, &ranged, &usable, &self.sensor);
-        // A frame older than the sketch's window shows rocks the rover has left behind: on
-        // sparse-large seed 3, after 47 stations that fused too few landmarks to push a new
-        // frame, station 51 registered six look-alikes of stations 0–3's rocks by chance
-        // (67 unsound relations).
-        self.history
-            .retain(|(station, _)| index <= station + sketch::WINDOW);
         let mut recent: Vec<Frame> = self
-            .history
+            .recent(index)
             .iter()
             .rev()
-            .map(|(_, frame)| frame)
+            .map(|s| &s.frame)
             .filter(|frame| frame.registrable())
             .take(RECENT_FRAMES)
             .cloned()
@@ -222,7 +213,7 @@ impl<C: Calculus> Mapper<C> {
             &self.association,
             &|landmark| self.last_seen.lately(landmark, index),
         );
-        let decisions = self.undo_disagreeing(decisions, &evidence.detections);
+        let decisions = self.undo_disagreeing(decisions, &evidence.detections, index);
         record.seconds.associate = start.elapsed().as_secs_f64();
 
         let start = Instant::now();
@@ -243,13 +234,14 @@ impl<C: Calculus> Mapper<C> {
         record
     }
 
-    /// The decisions with every match whose landmark an earlier station placed elsewhere
-    /// ([`agreement`]) held back, the landmark its only candidate: the detection is another
+    /// The decisions with every match whose landmark an earlier station (within the sketch's
+    /// window before `index`) placed elsewhere ([`agreement`]) held back, the landmark its only candidate: the detection is another
     /// rock, which may have a landmark of its own, so it is not made a new one on the spot.
     fn undo_disagreeing(
         &self,
         mut decisions: Vec<Decision>,
         evidence: &[Evidence],
+        index: usize,
     ) -> Vec<Decision> {
         let matched: Vec<(LandmarkId, Placed)> = decisions
             .iter()
@@ -259,7 +251,8 @@ impl<C: Calculus> Mapper<C> {
                 _ => None,
             })
             .collect();
-        let disagreeing = agreement::disagreeing(&matched, self.history.iter().map(|(_, f)| f));
+        let disagreeing =
+            agreement::disagreeing(&matched, self.recent(index).iter().map(|s| &s.frame));
         for decision in &mut decisions {
             if let Decision::Matched(l) = *decision {
                 if disagreeing.contains(&l) {
@@ -320,16 +313,7 @@ impl<C: Calculus> Mapper<C> {
                     self.revision += 1;
                 }
                 self.next_landmark = associated.next_landmark;
-                self.remember(record, &associated);
-                self.sighted.push(Sighted {
-                    station: record.index,
-                    bearings: associated
-                        .fused
-                        .iter()
-                        .map(|s| (s.landmark, view.bearings[s.position]))
-                        .collect(),
-                    frame: self.history.last().expect("remembered").1.clone(),
-                });
+                self.remember(record, &associated, &view);
                 self.hold_back(record, associated, view);
             }
             Err(contradiction) => {
@@ -342,9 +326,14 @@ impl<C: Calculus> Mapper<C> {
         }
     }
 
-    /// Records the fused detections' looks and sightings, and the station's frame for
-    /// registration at later stations.
-    fn remember(&mut self, record: &mut StationRecord, associated: &Associated) {
+    /// Records the fused detections' looks and sightings, and the station's bearings and frame
+    /// for registration at later stations and for 002's beliefs.
+    fn remember(
+        &mut self,
+        record: &mut StationRecord,
+        associated: &Associated,
+        view: &StationView,
+    ) {
         for s in &associated.fused {
             let i = associated.usable[s.position];
             let evidence = &associated.evidence[s.position];
@@ -371,7 +360,26 @@ impl<C: Calculus> Mapper<C> {
                 .collect(),
         };
         self.sketch.update(record.index, &frame.landmarks);
-        self.history.push((record.index, frame));
+        self.sighted.push(Sighted {
+            station: record.index,
+            bearings: associated
+                .fused
+                .iter()
+                .map(|s| (s.landmark, view.bearings[s.position]))
+                .collect(),
+            frame,
+        });
+    }
+
+    /// The stations within the sketch's window before `index`, oldest first. A frame older
+    /// than that shows rocks the rover has left behind: on sparse-large seed 3, after 47
+    /// stations that fused too few landmarks to push a new frame, station 51 registered six
+    /// look-alikes of stations 0–3's rocks by chance (67 unsound relations).
+    fn recent(&self, index: usize) -> &[Sighted] {
+        let start = self
+            .sighted
+            .partition_point(|s| s.station + sketch::WINDOW < index);
+        &self.sighted[start..]
     }
 
     /// Keeps the station's undecided detections to be tried again on a tighter map.
