@@ -13,7 +13,6 @@ use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
 use qrm_core::neighborhood::RngEstimate;
-use qrm_core::probabilistic::map::Variant;
 use qrm_plot::{spring_layout, write_panels, Curve, Panel};
 use qrm_synth::evaluation::Evaluation;
 use qrm_vision::calib::Calibration;
@@ -365,16 +364,13 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
         Mode::Probabilistic => {
             let start = Instant::now();
             let sighted = &traverse.mapper.sighted;
-            let beliefs = run_beliefs(sighted, &estimator, BELIEF_SEED);
+            let sd = bearing_sd(sighted);
+            let beliefs = run_beliefs(sighted, sd, &estimator, BELIEF_SEED);
             let summary = BeliefsSummary {
-                estimator: match estimator.variant {
-                    Variant::Fast => "fast",
-                    Variant::Full => "full",
-                }
-                .to_string(),
+                estimator: estimator.variant.name().to_string(),
                 triples_seen_twice: beliefs.seen_twice,
                 triples: beliefs.triples.len(),
-                bearing_sd_deg: bearing_sd(sighted).to_degrees(),
+                bearing_sd_deg: sd.to_degrees(),
                 wall_seconds: start.elapsed().as_secs_f64(),
             };
             Some((beliefs, summary))

@@ -614,10 +614,7 @@ fn probabilistic_single(
     let pct = |n: usize| 100.0 * n as f64 / c.triples.max(1) as f64;
     println!(
         "002 beliefs ({} estimator, ≤ {} views, motion noise {:.1}°) for {} triples seen from two or more points, in {elapsed:.2} s:",
-        match settings.estimator.variant {
-            Variant::Fast => "fast",
-            Variant::Full => "full",
-        },
+        settings.estimator.variant.name(),
         settings.estimator.views,
         settings.motion_noise.to_degrees(),
         c.triples

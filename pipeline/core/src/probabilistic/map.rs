@@ -34,6 +34,16 @@ pub enum Variant {
     Fast,
 }
 
+impl Variant {
+    /// `full` or `fast`, as in the settings of a beliefs file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Full => "full",
+            Variant::Fast => "fast",
+        }
+    }
+}
+
 /// How a triple's belief is estimated.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Estimator {
@@ -338,6 +348,7 @@ impl BeliefMap {
 
 #[cfg(test)]
 mod tests {
+    use super::super::triplet::angle_to;
     use super::*;
     use crate::edc;
 
@@ -358,10 +369,7 @@ mod tests {
             .iter()
             .map(|x| {
                 (0..landmarks.len() as LandmarkId)
-                    .map(|id| {
-                        let l = landmarks[id as usize];
-                        (id, (l.y - x.y).atan2(l.x - x.x))
-                    })
+                    .map(|id| (id, angle_to(*x, landmarks[id as usize])))
                     .collect()
             })
             .collect();
@@ -379,7 +387,7 @@ mod tests {
         // Only the displacement from station 0 to station 2 is known.
         let motions = |from: usize, to: usize, _: &mut dyn RngCore| {
             ((from, to) == (0, 2)).then(|| Heading {
-                angle: (at[2].y - at[0].y).atan2(at[2].x - at[0].x),
+                angle: angle_to(at[0], at[2]),
                 sd: 0.01,
             })
         };
@@ -407,7 +415,7 @@ mod tests {
         };
         let motions = |from: usize, to: usize, _: &mut dyn RngCore| {
             Some(Heading {
-                angle: (at[to].y - at[from].y).atan2(at[to].x - at[from].x),
+                angle: angle_to(at[from], at[to]),
                 sd: 0.01,
             })
         };

@@ -15,6 +15,22 @@ use qrm_core::neighborhood::{compare, estimate, RngEstimate};
 use std::collections::HashMap;
 use std::f64::consts::TAU;
 
+/// The true `AB:C` of landmarks `[a, b, c]`, each held to its majority rock. Soundness is
+/// checked on every landmark with one: a duplicate shares its rock's position (triples of two
+/// such landmarks are degenerate, so undefined), and a mixed landmark is held to its majority
+/// rock.
+pub(super) fn majority_relation(
+    truth: &Truth,
+    rocks: &LandmarkRocks,
+    landmarks: [LandmarkId; 3],
+) -> Option<u8> {
+    let [a, b, c] = landmarks.map(|l| {
+        let p = truth.rocks[rocks.majority(l)? as usize].position;
+        Some(Point::new(p[0], p[1]))
+    });
+    Edc::classify(a?, b?, c?)
+}
+
 pub(super) fn score(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> MapScore {
     let rock = |id: u32| {
         let p = truth.rocks[id as usize].position;
@@ -22,13 +38,8 @@ pub(super) fn score(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> Map
     };
     let defined = |l: LandmarkId| rocks.defined(l).is_some();
     let position = |l: LandmarkId| rocks.defined(l).map(rock);
-    // Soundness of the run's map is checked on every landmark with a majority rock: a duplicate
-    // shares its rock's position (triples of two such landmarks are degenerate, so undefined),
-    // and a mixed landmark is held to its majority rock.
-    let majority_truth = |a: LandmarkId, b: LandmarkId, c: LandmarkId| {
-        let at = |l: LandmarkId| rocks.majority(l).map(rock);
-        Edc::classify(at(a)?, at(b)?, at(c)?)
-    };
+    let majority_truth =
+        |a: LandmarkId, b: LandmarkId, c: LandmarkId| majority_relation(truth, rocks, [a, b, c]);
     let defined_truth = |a: LandmarkId, b: LandmarkId, c: LandmarkId| {
         Edc::classify(position(a)?, position(b)?, position(c)?)
     };

@@ -12,9 +12,7 @@ mod map;
 pub use detection::{match_detections, median_and_max, Detectable, DetectedBox, Score};
 
 use crate::dataset::{ImageTruth, Truth};
-use qrm_core::calculus::Calculus;
 use qrm_core::edc::Edc;
-use qrm_core::geometry::Point;
 use qrm_core::map::{Hypergraph, LandmarkId};
 use qrm_core::probabilistic::map::{compare, BeliefComparison, BeliefMap};
 use qrm_vision::calib::Calibration;
@@ -283,12 +281,8 @@ pub fn score_run(
         landmark_rocks: rocks.all(),
         map: map::score(run, truth, &rocks),
         beliefs: run.beliefs.map(|beliefs| {
-            let rock = |l: LandmarkId| {
-                let p = truth.rocks[rocks.majority(l)? as usize].position;
-                Some(Point::new(p[0], p[1]))
-            };
-            compare(beliefs, run.map, &|[a, b, c]| {
-                Edc::classify(rock(a)?, rock(b)?, rock(c)?)
+            compare(beliefs, run.map, &|ids| {
+                map::majority_relation(truth, &rocks, ids)
             })
         }),
     }

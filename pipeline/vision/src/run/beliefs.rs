@@ -26,8 +26,14 @@ pub fn bearing_sd(sighted: &[Sighted]) -> f64 {
     (median / 3f64.sqrt()).max(0.05f64.to_radians())
 }
 
-/// The beliefs of every triple fused together at two or more of the `sighted` stations.
-pub fn run_beliefs(sighted: &[Sighted], estimator: &Estimator, seed: u64) -> BeliefMap {
+/// The beliefs of every triple fused together at two or more of the `sighted` stations,
+/// bearings of s.d. `bearing_sd` ([`bearing_sd`]).
+pub fn run_beliefs(
+    sighted: &[Sighted],
+    bearing_sd: f64,
+    estimator: &Estimator,
+    seed: u64,
+) -> BeliefMap {
     let stations: Vec<BTreeMap<LandmarkId, f64>> = sighted
         .iter()
         .map(|s| s.bearings.iter().map(|(&l, b)| (l, b.angle)).collect())
@@ -38,7 +44,7 @@ pub fn run_beliefs(sighted: &[Sighted], estimator: &Estimator, seed: u64) -> Bel
             displacement(&sighted[from].frame, &sighted[to].frame)
                 .map(|(angle, sd)| Heading { angle, sd })
         },
-        bearing_sd(sighted),
+        bearing_sd,
         estimator,
         seed,
     )
