@@ -226,6 +226,10 @@ pub fn print_report(e: &Evaluation) {
         "  association: accuracy {:.3} ({} of {} sightings), {} landmarks, {} rocks duplicated, {} landmarks mixed, {} sightings of false detections",
         a.accuracy, a.correct_sightings, a.sightings, a.landmarks, a.duplicated_rocks, a.mixed_landmarks, a.unmatched_sightings
     );
+    println!(
+        "  reached the map: {:.1} % of detections matched to rocks; {} of the {} rocks detected at 3 or more stations have a landmark ({:.1} %)",
+        100.0 * a.fused_fraction, a.rocks_seen_thrice_mapped, a.rocks_seen_thrice, 100.0 * a.mapped_fraction
+    );
     for (name, m) in [("run", &e.map.run), ("exact", &e.map.exact)] {
         println!(
             "  map ({name:<5}): {} landmarks, {} triples, {:.1} % open ({:.1} % among landmarks of one rock each), {:.1} % of incorrect states removed, {:.1} % fully constrained, {} unsound relations",

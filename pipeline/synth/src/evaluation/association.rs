@@ -4,7 +4,7 @@ use super::detection::ratio;
 use super::{AssociationScore, MixedLandmark};
 use qrm_core::map::LandmarkId;
 use qrm_vision::run::LandmarkRecord;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 /// Which truth rock each landmark stands for.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -31,7 +31,7 @@ impl LandmarkRocks {
     }
 }
 
-/// Association figures, given the truth rock of every matched `(station, detection)`.
+/// Association figures, given the truth rock of every `(station, detection)` matched to one.
 pub(super) fn score(
     landmarks: &[LandmarkRecord],
     matched: &HashMap<(usize, usize), u32>,
@@ -68,6 +68,22 @@ pub(super) fn score(
     }
     a.duplicated_rocks = rocks.landmarks_of_rock.values().filter(|&&n| n > 1).count();
     a.accuracy = ratio(a.correct_sightings, a.sightings);
+    a.fused_fraction = ratio(a.correct_sightings, matched.len());
+    let mut stations_of_rock: HashMap<u32, BTreeSet<usize>> = HashMap::new();
+    for (&(station, _), &rock) in matched {
+        stations_of_rock.entry(rock).or_default().insert(station);
+    }
+    let thrice: Vec<u32> = stations_of_rock
+        .into_iter()
+        .filter(|(_, stations)| stations.len() >= 3)
+        .map(|(rock, _)| rock)
+        .collect();
+    a.rocks_seen_thrice = thrice.len();
+    a.rocks_seen_thrice_mapped = thrice
+        .iter()
+        .filter(|r| rocks.landmarks_of_rock.contains_key(r))
+        .count();
+    a.mapped_fraction = ratio(a.rocks_seen_thrice_mapped, a.rocks_seen_thrice);
     (a, rocks)
 }
 
@@ -123,5 +139,37 @@ mod tests {
         );
         assert_eq!((score.correct_sightings, score.unmatched_sightings), (5, 1));
         assert_eq!((rocks.majority(0), rocks.majority(1)), (Some(7), Some(8)));
+        // 5 of the 6 detections of rocks reached their rock's landmark; rock 7 alone was
+        // detected at three stations, and landmark 0 stands for it.
+        assert!((score.fused_fraction - 5.0 / 6.0).abs() < 1e-12);
+        assert_eq!(
+            (score.rocks_seen_thrice, score.rocks_seen_thrice_mapped),
+            (1, 1)
+        );
+    }
+
+    #[test]
+    fn a_rock_seen_thrice_without_a_landmark_of_its_own_is_not_mapped() {
+        // Rock 3 is detected at stations 0, 1 and 2, but its only sighting went to landmark 0,
+        // which stands for rock 4.
+        let matched: HashMap<(usize, usize), u32> = [
+            ((0, 0), 3),
+            ((1, 0), 3),
+            ((2, 0), 3),
+            ((0, 1), 4),
+            ((1, 1), 4),
+            ((2, 1), 4),
+            ((3, 1), 4),
+        ]
+        .into_iter()
+        .collect();
+        let landmarks = [landmark(0, &[(0, 1), (1, 1), (2, 0)])];
+        let (score, _) = score(&landmarks, &matched);
+        assert_eq!(
+            (score.rocks_seen_thrice, score.rocks_seen_thrice_mapped),
+            (2, 1)
+        );
+        assert!((score.mapped_fraction - 0.5).abs() < 1e-12);
+        assert!((score.fused_fraction - 2.0 / 7.0).abs() < 1e-12);
     }
 }

@@ -104,6 +104,14 @@ pub struct AssociationScore {
     pub mixed_landmarks: usize,
     /// Sightings of things that are not truth rocks (false detections).
     pub unmatched_sightings: usize,
+    /// Correct sightings over the detections matched to a rock: the share of correct
+    /// detections that reached the map (issue 13's "fused").
+    pub fused_fraction: f64,
+    /// Rocks detected at three or more stations, and how many of them some landmark stands
+    /// for: what a map of the drive could hold (issues 13 and 14's "mapped").
+    pub rocks_seen_thrice: usize,
+    pub rocks_seen_thrice_mapped: usize,
+    pub mapped_fraction: f64,
     /// Every mixed landmark with the stations that saw each of its rocks: where association
     /// went wrong.
     pub mixed: Vec<MixedLandmark>,
