@@ -89,6 +89,7 @@ impl<C: Calculus> KnownMap<C> {
             .iter()
             .map(|record| Frame {
                 accumulated: false,
+                departed: Vec::new(),
                 landmarks: record
                     .detections
                     .iter()

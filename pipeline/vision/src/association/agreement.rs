@@ -59,6 +59,7 @@ mod tests {
     fn frame(points: &[(LandmarkId, [f64; 2])]) -> Frame {
         Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: points
                 .iter()
                 .map(|&(l, point)| (l, Placed { point, radius: 0.3 }))
@@ -190,6 +191,7 @@ mod tests {
             }
             history.push(Frame {
                 accumulated: false,
+                departed: Vec::new(),
                 landmarks: seen
                     .iter()
                     .map(|&r| (label(r, b_landmark), placed(r)))

@@ -78,6 +78,16 @@ const MIN_UNSEEN: usize = 2;
 /// out the true landmark would make a duplicate.
 const PLACEMENT_SLACK_M: f64 = 1.0;
 
+/// Slack of the placement test against the sketch, metres. The sketch's averaged positions
+/// are tighter than a detection's placement is right (a range interval's middle is not the
+/// rock's centre): at [`PLACEMENT_SLACK_M`] it ruled out known rocks and made new landmarks
+/// of them (random seed 5: 7 → 11 rocks duplicated).
+const SKETCH_SLACK_M: f64 = 3.0;
+
+/// Drift of the sketch, as a share of the distance from the station to a departed landmark's
+/// last position.
+const DRIFT: f64 = 0.25;
+
 /// Thresholds of association.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AssociationSettings {
@@ -247,8 +257,12 @@ fn unaccounted_near(
 /// Whether the station's placement `p`, moved into a frame by `registration`, lies within
 /// placement slack of the frame's landmark placed at `q`.
 fn within_placement(p: Placed, q: Placed, registration: &Registration) -> bool {
+    within(p, q, registration, PLACEMENT_SLACK_M)
+}
+
+fn within(p: Placed, q: Placed, registration: &Registration, slack: f64) -> bool {
     registration::distance(registration.to_frame(p.point), q.point)
-        <= p.radius + q.radius + PLACEMENT_SLACK_M
+        <= p.radius + q.radius + slack
 }
 
 /// The frames the station registers against, with their registrations (see [`register`]).
@@ -260,14 +274,6 @@ fn registrations<'f>(
     lately: &dyn Fn(LandmarkId) -> bool,
 ) -> Vec<(&'f Frame, Registration)> {
     let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
-    // Registration hypotheses grow with the square of the seeds: each detection seeds only
-    // with its closest few look-alikes (the lists are sorted by descriptor distance).
-    let seed = |i: usize, l: LandmarkId| {
-        candidates[i]
-            .iter()
-            .take(REGISTRATION_SEEDS)
-            .any(|c| c.0 == l)
-    };
     // How far this station places rocks: a landmark the motion brings farther may be beyond
     // detection, so its absence says nothing.
     let reach = placed
@@ -277,7 +283,19 @@ fn registrations<'f>(
         .fold(0.0, f64::max);
     let registrations: Vec<(&Frame, Registration)> = frames
         .iter()
-        .filter_map(|frame| Some((frame, register(placed, frame, &alike, &seed)?)))
+        .filter_map(|frame| {
+            // Registration hypotheses grow with the square of the seeds: each detection seeds
+            // only with its closest few look-alikes among the frame's landmarks (the lists are
+            // sorted by descriptor distance).
+            let seed = |i: usize, l: LandmarkId| {
+                candidates[i]
+                    .iter()
+                    .filter(|c| frame.landmarks.iter().any(|m| m.0 == c.0))
+                    .take(REGISTRATION_SEEDS)
+                    .any(|c| c.0 == l)
+            };
+            Some((frame, register(placed, frame, &alike, &seed)?))
+        })
         .filter(|(frame, registration)| {
             registration.pairs.len() > MIN_INLIERS
                 || registration.unseen(frame, bearings, reach) < MIN_UNSEEN
@@ -359,19 +377,25 @@ fn placed_near(
         .map(|(i, list)| {
             list.into_iter()
                 .filter(|&(l, _)| {
+                    let Some(p) = placed[i] else {
+                        return true;
+                    };
                     registrations.iter().all(|(frame, r)| {
-                        // The sketch's averaged positions are tighter than the detection's
-                        // placement is right (a range interval's middle is not the rock's
-                        // centre): ruling out by them made new landmarks of known rocks
-                        // (random seed 5: 7 → 11 rocks duplicated). It proposes, never rules
-                        // out.
-                        if frame.accumulated {
-                            return true;
+                        if let Some((_, q)) = frame.landmarks.iter().find(|f| f.0 == l) {
+                            let slack = if frame.accumulated {
+                                SKETCH_SLACK_M
+                            } else {
+                                PLACEMENT_SLACK_M
+                            };
+                            return within(p, *q, r, slack);
                         }
-                        match (placed[i], frame.landmarks.iter().find(|f| f.0 == l)) {
-                            (Some(p), Some((_, q))) => within_placement(p, *q, r),
-                            _ => true,
-                        }
+                        // A landmark the rover left behind lies where the sketch last put it,
+                        // give or take the sketch's drift since, which grows with the way
+                        // back to it.
+                        frame.departed.iter().find(|f| f.0 == l).is_none_or(|(_, q)| {
+                            let way = registration::distance(r.to_frame([0.0, 0.0]), q.point);
+                            within(p, *q, r, SKETCH_SLACK_M + DRIFT * way)
+                        })
                     })
                 })
                 .collect()
@@ -659,6 +683,7 @@ mod tests {
     fn frame(points: &[[f64; 2]]) -> Frame {
         Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: points
                 .iter()
                 .enumerate()

@@ -27,6 +27,10 @@ pub struct Frame {
     /// holds more look-alikes near each landmark than one station sees, so leaving a landmark
     /// unpaired is no evidence against a pair other frames make.
     pub accumulated: bool,
+    /// Landmarks that left the sketch, placed in its coordinates where they were last seen:
+    /// never registered against, only used to rule out look-alikes far from where they can
+    /// still be (empty for a station's frame).
+    pub departed: Vec<(LandmarkId, Placed)>,
 }
 
 impl Frame {
@@ -685,6 +689,7 @@ pub(super) mod tests {
     fn field_frame() -> Frame {
         Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: FIELD
                 .iter()
                 .enumerate()
@@ -699,6 +704,7 @@ pub(super) mod tests {
         let (sin, cos) = turn.sin_cos();
         Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: FIELD
                 .iter()
                 .enumerate()
@@ -755,6 +761,7 @@ pub(super) mod tests {
         };
         let frame = Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: (0..20).map(|k| (k as LandmarkId, place(12.0))).collect(),
         };
         let current: Vec<Option<Placed>> =
@@ -827,6 +834,7 @@ pub(super) mod tests {
         let (angle, shift) = (0.7f64, [1.5, -0.8]);
         let frame = Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: field
                 .iter()
                 .enumerate()
@@ -875,6 +883,7 @@ pub(super) mod tests {
         let place = |point: [f64; 2], radius: f64| Placed { point, radius };
         let frame = Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: FIELD
                 .iter()
                 .chain(&[[12.0, -12.0]])
@@ -901,6 +910,7 @@ pub(super) mod tests {
         let place = |point: [f64; 2]| Placed { point, radius: 0.2 };
         let frame = Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: vec![(10, place([3.0, 1.0])), (11, place([5.0, -2.0]))],
         };
         let placed = [Some(place([3.0, 1.6])), Some(place([5.0, -2.0]))];
@@ -919,6 +929,7 @@ pub(super) mod tests {
         let place = |point: [f64; 2]| Placed { point, radius: 1.0 };
         let frame = Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: FIELD
                 .iter()
                 .enumerate()
@@ -991,6 +1002,7 @@ pub(super) mod tests {
     fn too_few_correspondences_register_nothing() {
         let frame = Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: vec![(
                 1,
                 Placed {

@@ -46,6 +46,9 @@ struct Sketched {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Sketch {
     landmarks: Vec<Sketched>,
+    /// Landmarks not seen for [`WINDOW`] stations, where the sketch last placed them, until
+    /// the sketch starts again.
+    departed: Vec<Sketched>,
     /// The last station whose sightings entered the sketch.
     updated: Option<usize>,
 }
@@ -60,6 +63,13 @@ impl Sketch {
                 .landmarks
                 .iter()
                 .filter(|s| station <= s.seen + WINDOW)
+                .map(|s| (s.landmark, s.placed))
+                .collect(),
+            departed: self
+                .landmarks
+                .iter()
+                .chain(&self.departed)
+                .filter(|s| station > s.seen + WINDOW)
                 .map(|s| (s.landmark, s.placed))
                 .collect(),
         }
@@ -77,6 +87,7 @@ impl Sketch {
             Some(motion) => motion,
             None if self.updated.is_none_or(|u| station > u + WINDOW) => {
                 self.landmarks.clear();
+                self.departed.clear();
                 Motion::identity()
             }
             None => return false,
@@ -88,7 +99,13 @@ impl Sketch {
             };
             self.merge(landmark, placed, station);
         }
-        self.landmarks.retain(|s| station <= s.seen + WINDOW);
+        let (kept, departed): (Vec<Sketched>, Vec<Sketched>) = std::mem::take(&mut self.landmarks)
+            .into_iter()
+            .partition(|s| station <= s.seen + WINDOW);
+        self.landmarks = kept;
+        self.departed
+            .retain(|d| !self.landmarks.iter().any(|s| s.landmark == d.landmark));
+        self.departed.extend(departed);
         self.updated = Some(station);
         true
     }

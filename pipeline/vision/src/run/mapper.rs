@@ -353,6 +353,7 @@ impl<C: Calculus> Mapper<C> {
         }
         let frame = Frame {
             accumulated: false,
+            departed: Vec::new(),
             landmarks: associated
                 .fused
                 .iter()
