@@ -693,6 +693,37 @@ mod tests {
     }
 
     #[test]
+    fn the_sketch_rules_out_look_alikes_far_from_where_it_puts_them() {
+        // Registered against the sketch with no motion, a detection 9.8 m from the station.
+        // Landmark 1 is in the sketch 7 m from it: out, beyond the sketch's 3 m slack. The
+        // rover left landmarks 2, 3 and 4 behind: 2 lies 1 m from the detection (kept), 3
+        // lies 7 m from it but 16.5 m from the station, within the drift that way allows
+        // (kept), and 4, 50 m off, cannot be this rock (out).
+        let detection = [4.0, -9.0];
+        let sketch = Frame {
+            accumulated: true,
+            landmarks: vec![(0, at([10.0, 10.0])), (1, at([4.0, -16.0]))],
+            departed: vec![
+                (2, at([4.0, -10.0])),
+                (3, at([4.0, -16.0])),
+                (4, at([40.0, 30.0])),
+            ],
+        };
+        let registration = Registration {
+            pairs: Vec::new(),
+            motion: [1.0, 0.0, 0.0, 0.0],
+        };
+        let candidates = vec![(1..=4).map(|l| (l, 0.1)).collect()];
+        let kept = placed_near(
+            candidates,
+            &[(&sketch, registration)],
+            &[Some(at(detection))],
+        );
+        let kept: Vec<LandmarkId> = kept[0].iter().map(|c| c.0).collect();
+        assert_eq!(kept, vec![2, 3]);
+    }
+
+    #[test]
     fn registered_landmarks_are_matched_and_a_lone_look_alike_is_held_back() {
         // Landmark 6 lies where the motion puts detection 6, but just as near detection 7 (a
         // rock of another look): registration leaves it unanchored, placement and the empty

@@ -238,11 +238,29 @@ mod tests {
         assert!(sketch.frame(WINDOW + 1).landmarks.is_empty());
         // Two unrelated rocks share nothing with the sketch: left out while it may be found
         // again, the start of a new sketch once it is lost.
+        let departed = sketch.frame(WINDOW + 1).departed;
+        assert_eq!(departed.len(), 4, "kept where they were last placed");
         let elsewhere = seen(0.0, [50.0, 0.0], &[4, 5]);
         assert!(!sketch.update(5, &elsewhere));
         assert!(sketch.update(WINDOW + 1, &elsewhere));
         let frame = sketch.frame(WINDOW + 1);
         let ids: Vec<LandmarkId> = frame.landmarks.iter().map(|l| l.0).collect();
         assert_eq!(ids, vec![4, 5]);
+        assert!(frame.departed.is_empty(), "a new sketch forgets the old one");
+    }
+
+    #[test]
+    fn a_departed_landmark_seen_again_rejoins_the_sketch() {
+        let mut sketch = Sketch::default();
+        sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]));
+        sketch.update(WINDOW, &seen(0.0, [0.0, 0.0], &[1, 2, 3]));
+        let frame = sketch.frame(WINDOW + 1);
+        let departed: Vec<LandmarkId> = frame.departed.iter().map(|d| d.0).collect();
+        assert_eq!(departed, vec![0]);
+        assert!(distance(frame.departed[0].1.point, FIELD[0]) < 1e-9);
+        sketch.update(WINDOW + 2, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]));
+        let frame = sketch.frame(WINDOW + 2);
+        assert!(frame.departed.is_empty());
+        assert!(frame.landmarks.iter().any(|l| l.0 == 0));
     }
 }
