@@ -285,16 +285,28 @@ fn registrations<'f>(
         .iter()
         .filter_map(|frame| {
             // Registration hypotheses grow with the square of the seeds: each detection seeds
-            // only with its closest few look-alikes among the frame's landmarks (the lists are
-            // sorted by descriptor distance).
-            let seed = |i: usize, l: LandmarkId| {
+            // only with its closest few look-alikes (the lists are sorted by descriptor
+            // distance) in the whole gallery, and failing that, among the frame's landmarks.
+            // In a large gallery of look-alikes the closest few are mostly elsewhere
+            // (`sparse-large` seed 3, station 57: 1 of 7 rocks shared with the last station
+            // had its landmark among its 6 closest, 3 among the frame's 6 closest), but more
+            // seeds also give chance fits more tries, so they are the second resort.
+            let closest = |i: usize, l: LandmarkId| {
+                candidates[i]
+                    .iter()
+                    .take(REGISTRATION_SEEDS)
+                    .any(|c| c.0 == l)
+            };
+            let closest_in_frame = |i: usize, l: LandmarkId| {
                 candidates[i]
                     .iter()
                     .filter(|c| frame.landmarks.iter().any(|m| m.0 == c.0))
                     .take(REGISTRATION_SEEDS)
                     .any(|c| c.0 == l)
             };
-            Some((frame, register(placed, frame, &alike, &seed)?))
+            let registration = register(placed, frame, &alike, &closest)
+                .or_else(|| register(placed, frame, &alike, &closest_in_frame))?;
+            Some((frame, registration))
         })
         .filter(|(frame, registration)| {
             registration.pairs.len() > MIN_INLIERS
