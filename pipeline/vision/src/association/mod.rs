@@ -85,7 +85,8 @@ const PLACEMENT_SLACK_M: f64 = 1.0;
 const SKETCH_SLACK_M: f64 = 3.0;
 
 /// Drift of the sketch, as a share of the distance from the station to a departed landmark's
-/// last position.
+/// last position: generous, since ruling out the true landmark of a loop closure would make a
+/// duplicate.
 const DRIFT: f64 = 0.25;
 
 /// Thresholds of association.
@@ -377,7 +378,12 @@ fn anchors(
 }
 
 /// The candidates of each detection less those a registered frame places away from where its
-/// motion puts the detection.
+/// motion puts the detection: a station's frame within [`PLACEMENT_SLACK_M`], the sketch within
+/// [`SKETCH_SLACK_M`], and a landmark that left the sketch within that plus [`DRIFT`] of the way
+/// to where the sketch last put it. A rock entering view on a long drive otherwise keeps every
+/// old look-alike the loose map cannot reject for a candidate, is held back and given up, and
+/// the map stops growing (`sparse-large` seed 3: nothing fused at stations 57–81 and 105–119;
+/// with the departed landmarks, 70 % of the correct detections fused instead of 34 %).
 fn placed_near(
     candidates: Vec<Vec<(LandmarkId, f64)>>,
     registrations: &[(&Frame, Registration)],
