@@ -199,7 +199,7 @@ pub fn associate<C: Calculus>(
     } else {
         settings.min_support_without_colour
     };
-    let mut anchors = anchors(&registrations, &candidates, min_support);
+    let mut anchors = anchors(&registrations, &candidates, &placed, min_support);
     let candidates = placed_near(candidates, &registrations, &placed);
     drop_inconsistent_anchors(map, view, &mut anchors);
     let anchored: Vec<Sighting> = anchors.iter().map(|a| Sighting::new(a.0, a.1)).collect();
@@ -339,6 +339,7 @@ fn registrations<'f>(
 fn anchors(
     registrations: &[(&Frame, Registration)],
     candidates: &[Vec<(LandmarkId, f64)>],
+    placed: &[Option<Placed>],
     min_support: usize,
 ) -> Vec<(usize, LandmarkId, f64)> {
     let mut pairs: Vec<(usize, LandmarkId)> = registrations
@@ -359,10 +360,14 @@ fn anchors(
             .iter()
             // The sketch holds more look-alikes near each landmark than one station sees, so
             // its leaving a pair out is abstention, not doubt (counted as doubt, it cost 13 %
-            // of random seed 5's sightings).
+            // of random seed 5's sightings), unless its motion puts the detection far from
+            // the landmark: then the two registrations disagree on where the rover is.
             .filter(|(frame, r)| {
-                frame.landmarks.iter().any(|m| m.0 == l)
-                    && (!frame.accumulated || r.pairs.iter().any(|p| p.0 == i || p.1 == l))
+                frame.landmarks.iter().find(|m| m.0 == l).is_some_and(|(_, q)| {
+                    !frame.accumulated
+                        || r.pairs.iter().any(|p| p.0 == i || p.1 == l)
+                        || placed[i].is_some_and(|p| !within(p, *q, r, SKETCH_SLACK_M))
+                })
             })
             .count();
         2 * support > holding && support >= min_support
