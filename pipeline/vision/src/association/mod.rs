@@ -194,6 +194,7 @@ pub fn associate<C: Calculus>(
     for (frame, registration) in &mut registrations {
         registration.drop_pairs_seen_elsewhere(frame, &placed, &elsewhere);
     }
+    registrations.retain(|(_, registration)| registration.pairs.len() >= MIN_INLIERS);
     let min_support = if station.colour {
         1
     } else {
