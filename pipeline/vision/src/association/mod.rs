@@ -194,6 +194,10 @@ pub fn associate<C: Calculus>(
     for (frame, registration) in &mut registrations {
         registration.drop_pairs_seen_elsewhere(frame, &placed, &elsewhere);
     }
+    // The dropped pairs' landmarks may be other rocks, so they no longer support the motion:
+    // fewer than the fewest believed left, and the fit is not trusted (the 1 000-rock drive,
+    // stations 62–66: 4-pair fits left with 1 or 2 pairs anchored rocks 15–59 m from their
+    // landmarks' own).
     registrations.retain(|(_, registration)| registration.pairs.len() >= MIN_INLIERS);
     let min_support = if station.colour {
         1
@@ -745,6 +749,69 @@ mod tests {
         );
         let kept: Vec<LandmarkId> = kept[0].iter().map(|c| c.0).collect();
         assert_eq!(kept, vec![2, 3]);
+    }
+
+    #[test]
+    fn a_pair_the_sketch_places_far_apart_is_no_anchor() {
+        // A station's frame pairs detection 0 with landmark 0. The sketch registered too and
+        // left the pair out: abstention if its motion puts the detection near the landmark,
+        // doubt if it puts it 19 m away (the two registrations disagree on where the rover is).
+        let placed = [Some(at(FIELD[0]))];
+        let candidates = vec![vec![(0, 0.1)]];
+        let station_frame = frame(&[FIELD[0]]);
+        let by_frame = Registration {
+            pairs: vec![(0, 0)],
+            motion: [1.0, 0.0, 0.0, 0.0],
+        };
+        let sketch = |q: [f64; 2]| Frame {
+            accumulated: true,
+            landmarks: vec![(0, at(q))],
+            departed: Vec::new(),
+        };
+        let by_sketch = Registration {
+            pairs: Vec::new(),
+            motion: [1.0, 0.0, 0.0, 0.0],
+        };
+        let near = sketch([3.5, 1.0]);
+        let registrations = [(&station_frame, by_frame.clone()), (&near, by_sketch.clone())];
+        assert_eq!(
+            anchors(&registrations, &candidates, &placed, 1),
+            vec![(0, 0, 0.1)]
+        );
+        let far = sketch([20.0, 10.0]);
+        let registrations = [(&station_frame, by_frame), (&far, by_sketch)];
+        assert!(anchors(&registrations, &candidates, &placed, 1).is_empty());
+    }
+
+    #[test]
+    fn a_registration_left_with_too_few_pairs_anchors_nothing() {
+        // Six look-alikes register, each detection a little off its landmark. Unplaced
+        // detections lie in the directions of landmarks 0, 1 and 2, which may be those rocks:
+        // their pairs are dropped, and the three pairs left are too few to trust the motion.
+        // With only two such directions, the four pairs left anchor.
+        let offset: Vec<[f64; 2]> = FIELD
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                // 10 cm across the line of sight, alternately either way.
+                let side = if k % 2 == 0 { 0.1 } else { -0.1 };
+                let r = p[0].hypot(p[1]);
+                [p[0] - side * p[1] / r, p[1] + side * p[0] / r]
+            })
+            .collect();
+        let direction = |p: [f64; 2]| p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU);
+        let mut station = station(&offset);
+        station.1.unused_bearings = FIELD[..3].iter().map(|&p| direction(p)).collect();
+        let decisions = associate_station(&station, &[frame(&FIELD)]);
+        assert!(
+            decisions.iter().all(|d| !matches!(d, Decision::Matched(_))),
+            "{decisions:?}"
+        );
+        station.1.unused_bearings.truncate(2);
+        let decisions = associate_station(&station, &[frame(&FIELD)]);
+        for (i, decision) in decisions.iter().enumerate().skip(2) {
+            assert_eq!(*decision, Decision::Matched(i as LandmarkId));
+        }
     }
 
     #[test]
