@@ -57,6 +57,9 @@ impl Frame {
 pub struct Registration {
     pub pairs: Vec<(usize, LandmarkId)>,
     pub motion: [f64; 4],
+    /// How many chance fits as tight as this one the hypotheses tried should give
+    /// ([`super::significance`]): far below one, the fit is no accident.
+    pub nfa: f64,
 }
 
 /// Slack added to every distance comparison, metres (rock reference points are not points).
@@ -76,7 +79,7 @@ const UNSEEN_WINDOW_RAD: f64 = 0.05;
 /// Fewest correspondences a registration must explain to be believed.
 pub(super) const MIN_INLIERS: usize = 4;
 /// Most false alarms expected of a registration accepted on the significance of its fit …
-const SIGNIFICANT_NFA: f64 = 0.01;
+pub(super) const SIGNIFICANT_NFA: f64 = 0.01;
 /// … while every rival assignment's fit is no better than this many false alarms: what chance
 /// gives.
 const CHANCE_NFA: f64 = 1.0;
@@ -115,14 +118,15 @@ pub fn register(
         &seeds,
         &Candidates::new(current, frame, &correspondences),
     );
-    let inliers = decisive(&hypotheses).or_else(|| {
-        let chance = chance(frame, &seeds, &correspondences);
-        significant(current, frame, &hypotheses, &chance)
-    })?;
+    let chance = chance(frame, &seeds, &correspondences);
+    let inliers =
+        decisive(&hypotheses).or_else(|| significant(current, frame, &hypotheses, &chance))?;
+    let nfa = core(current, frame, &inliers, &chance).0;
     let (motion, pairs) = unambiguous(current, frame, &inliers);
     (pairs.len() >= MIN_INLIERS).then(|| Registration {
         pairs,
         motion: [motion.cos, motion.sin, motion.shift[0], motion.shift[1]],
+        nfa,
     })
 }
 
@@ -815,6 +819,7 @@ pub(super) mod tests {
         let registration = Registration {
             pairs: vec![(0, 0), (1, 1), (2, 2)],
             motion: [1.0, 0.0, 0.0, 0.0],
+            nfa: 0.0,
         };
         let bearing = |p: [f64; 2]| p[1].atan2(p[0]);
         let detected: Vec<f64> = FIELD[..4].iter().map(|&p| bearing(p)).collect();
@@ -917,6 +922,7 @@ pub(super) mod tests {
         let mut registration = Registration {
             pairs: vec![(0, 10), (1, 11)],
             motion: [1.0, 0.0, 0.0, 0.0],
+            nfa: 0.0,
         };
         registration.drop_pairs_seen_elsewhere(&frame, &placed, &[1f64.atan2(3.0), 2.0]);
         assert_eq!(registration.pairs, vec![(1, 11)]);

@@ -246,7 +246,10 @@ mod tests {
         let frame = sketch.frame(WINDOW + 1);
         let ids: Vec<LandmarkId> = frame.landmarks.iter().map(|l| l.0).collect();
         assert_eq!(ids, vec![4, 5]);
-        assert!(frame.departed.is_empty(), "a new sketch forgets the old one");
+        assert!(
+            frame.departed.is_empty(),
+            "a new sketch forgets the old one"
+        );
     }
 
     #[test]
