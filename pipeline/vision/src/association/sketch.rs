@@ -9,9 +9,11 @@
 //! there by the rigid motion its fused landmarks fit), averaging their placements, so that a
 //! new station registers against all the landmarks in view at once, with tighter positions.
 //!
-//! The sketch only *proposes*, like any frame (`super::register`): the map stays qualitative
-//! and is never fed a metric position. Landmarks not seen for [`WINDOW`] stations leave the
-//! sketch, so its drift over a long traverse never reaches the registration.
+//! The sketch proposes and rules out, like any frame (`super::register`): the map stays
+//! qualitative and is never fed a metric position. Landmarks not seen for [`WINDOW`] stations
+//! leave the registration, so its drift over a long traverse never reaches it; they stay
+//! where the sketch last put them (`Frame::departed`) until the sketch starts again, to rule
+//! out look-alikes far from there.
 
 use super::registration::{misfit, Frame, Motion, Placed};
 use qrm_core::map::LandmarkId;
