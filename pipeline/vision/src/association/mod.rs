@@ -254,7 +254,7 @@ fn unaccounted_near(
         .iter()
         .flat_map(|(frame, r)| {
             frame.landmarks.iter().filter(move |(l, q)| {
-                !anchored.iter().any(|a| a.landmark == *l) && within_placement(p, *q, r)
+                !anchored.iter().any(|a| a.landmark == *l) && within(p, *q, r, PLACEMENT_SLACK_M)
             })
         })
         .map(|(l, _)| *l)
@@ -265,11 +265,7 @@ fn unaccounted_near(
 }
 
 /// Whether the station's placement `p`, moved into a frame by `registration`, lies within
-/// placement slack of the frame's landmark placed at `q`.
-fn within_placement(p: Placed, q: Placed, registration: &Registration) -> bool {
-    within(p, q, registration, PLACEMENT_SLACK_M)
-}
-
+/// `slack` metres beyond the two radii of the frame's landmark placed at `q`.
 fn within(p: Placed, q: Placed, registration: &Registration, slack: f64) -> bool {
     registration::distance(registration.to_frame(p.point), q.point) <= p.radius + q.radius + slack
 }
