@@ -270,6 +270,18 @@ fn within(p: Placed, q: Placed, registration: &Registration, slack: f64) -> bool
     registration::distance(registration.to_frame(p.point), q.point) <= p.radius + q.radius + slack
 }
 
+/// Whether `frame`, registered by `registration`, places the detection at `p` where it may be
+/// the landmark it placed at `q`: within [`SKETCH_SLACK_M`] for the sketch, whose averaged
+/// positions are tighter than they are right, [`PLACEMENT_SLACK_M`] for a station's frame.
+fn placed_as(frame: &Frame, registration: &Registration, p: Placed, q: Placed) -> bool {
+    let slack = if frame.accumulated {
+        SKETCH_SLACK_M
+    } else {
+        PLACEMENT_SLACK_M
+    };
+    within(p, q, registration, slack)
+}
+
 /// The frames the station registers against, with their registrations (see [`register`]).
 fn registrations<'f>(
     frames: &'f [Frame],
@@ -384,7 +396,7 @@ fn anchors(
                     .is_some_and(|(_, q)| {
                         !frame.accumulated
                             || r.pairs.iter().any(|p| p.0 == i || p.1 == l)
-                            || placed[i].is_some_and(|p| !within(p, *q, r, SKETCH_SLACK_M))
+                            || placed[i].is_some_and(|p| !placed_as(frame, r, p, *q))
                     })
             })
             .count();
@@ -423,12 +435,7 @@ fn placed_near(
                     };
                     registrations.iter().all(|(frame, r)| {
                         if let Some((_, q)) = frame.landmarks.iter().find(|f| f.0 == l) {
-                            let slack = if frame.accumulated {
-                                SKETCH_SLACK_M
-                            } else {
-                                PLACEMENT_SLACK_M
-                            };
-                            return within(p, *q, r, slack);
+                            return placed_as(frame, r, p, *q);
                         }
                         // A landmark the rover left behind lies where the sketch last put it,
                         // give or take the sketch's drift since, which grows with the way
