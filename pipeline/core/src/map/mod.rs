@@ -7,6 +7,7 @@
 //! - [`Hypergraph::observations`]: the measured triples of a panorama's [`Sighting`]s as
 //!   observations, measured against what the map still allows (000 §IV, §VI-B);
 //! - [`Hypergraph::merge`]: fusing another map over the same landmark ids;
+//! - [`Journal`]: the fused views, replayed to take wrong sightings back out;
 //! - [`Network`]: constraint networks from outside, closed or narrowed to a minimal conflict;
 //! - [`Hypergraph::realize`]: positions under which every relation holds, for drawing;
 //! - JSON files (`docs/MAP_FORMAT.md`).
@@ -14,6 +15,7 @@
 mod closure;
 mod hypergraph;
 mod index;
+mod journal;
 mod json;
 mod kernel;
 mod network;
@@ -27,6 +29,7 @@ mod update;
 pub(crate) mod testing;
 
 pub use hypergraph::{Hypergraph, Triples};
+pub use journal::{Journal, Replay};
 pub use json::{MapFormatError, MAX_LANDMARKS};
 pub use network::{Network, NetworkTextError};
 pub use observe::Sighting;

@@ -52,6 +52,23 @@ pub fn disagreeing<'f>(
     out
 }
 
+/// What the two stations' frames `a` and `b` say of landmark `l`, both placing it: `Some(true)`
+/// when the motion between them that at least [`FEWEST_OTHERS`] other shared landmarks agree
+/// on brings its two placements together, `Some(false)` when it does not, `None` when too few
+/// others are shared to say.
+pub fn witness(a: &Frame, b: &Frame, l: LandmarkId) -> Option<bool> {
+    let pairs: Vec<(LandmarkId, (Placed, Placed))> = a
+        .landmarks
+        .iter()
+        .filter_map(|&(m, p)| Some((m, (p, b.landmarks.iter().find(|n| n.0 == m)?.1))))
+        .collect();
+    let k = pairs.iter().position(|s| s.0 == l)?;
+    let placements: Vec<(Placed, Placed)> = pairs.iter().map(|s| s.1).collect();
+    let agree = Motion::agreed(&placements, FEWEST_OTHERS)?;
+    let others = agree.iter().filter(|&&a| a).count() - usize::from(agree[k]);
+    (others >= FEWEST_OTHERS).then_some(agree[k])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

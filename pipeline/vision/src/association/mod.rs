@@ -35,6 +35,7 @@
 //! anchors; the wrong ones made 8 of those 12 maps unsound.
 
 pub mod agreement;
+pub mod audit;
 mod gallery;
 mod recency;
 mod registration;
@@ -203,6 +204,7 @@ pub fn associate<C: Calculus>(
     // stations 62–66: 4-pair fits left with 1 or 2 pairs anchored rocks 15–59 m from their
     // landmarks' own).
     registrations.retain(|(_, registration)| registration.pairs.len() >= MIN_INLIERS);
+    let registrations = believed(registrations, frames);
     let min_support = if station.colour {
         1
     } else {
@@ -298,7 +300,7 @@ fn registrations<'f>(
         .flatten()
         .map(|p| p.point[0].hypot(p.point[1]))
         .fold(0.0, f64::max);
-    let registrations: Vec<(&Frame, Registration)> = frames
+    frames
         .iter()
         .filter_map(|frame| {
             // Registration hypotheses grow with the square of the seeds: each detection seeds
@@ -331,7 +333,17 @@ fn registrations<'f>(
         })
         // A registration must hold a landmark the rover saw lately: see `recency`.
         .filter(|(_, registration)| registration.pairs.iter().any(|p| lately(p.1)))
-        .collect();
+        .collect()
+}
+
+/// The registrations less a station's only one when it is not believed. Applied once the
+/// pairs seen elsewhere are dropped: a registration dropped then leaves another alone (the
+/// 1 000-rock drive, station 380: a 4-pair fit of NFA 0.8, the lone survivor of two, paired
+/// four detections with rocks 19–31 m from their landmarks' own; 144 unsound relations).
+fn believed<'f>(
+    registrations: Vec<(&'f Frame, Registration)>,
+    frames: &[Frame],
+) -> Vec<(&'f Frame, Registration)> {
     // A station's only registration is a chance fit of look-alikes when several other frames
     // hold enough of its landmarks to have found the same pairing and none did.
     match registrations.as_slice() {
@@ -809,6 +821,29 @@ mod tests {
         );
         let decisions = associate_station(&seen(0.05), &[landmarks]);
         assert_eq!(decisions, (0..4).map(Decision::Matched).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn a_registration_left_alone_once_pairs_are_dropped_is_judged_alone() {
+        // Two frames registered; the second lost its pairs to detections without a placement
+        // and was dropped. The first, a 4-pair fit no more surprising than chance, is now the
+        // station's only registration and is not believed; beside a second one it would be.
+        let (first, second) = (frame(&FIELD[..4]), frame(&FIELD[..5]));
+        let loose = Registration {
+            pairs: (0..4).map(|l| (l, l as LandmarkId)).collect(),
+            motion: [1.0, 0.0, 0.0, 0.0],
+            nfa: 0.8,
+        };
+        let left = |registrations: Vec<(&Frame, Registration)>| {
+            believed(registrations, &[first.clone(), second.clone()]).len()
+        };
+        assert_eq!(left(vec![(&first, loose.clone())]), 0);
+        assert_eq!(
+            left(vec![(&first, loose.clone()), (&second, loose.clone())]),
+            2
+        );
+        let significant = Registration { nfa: 0.001, ..loose };
+        assert_eq!(left(vec![(&first, significant)]), 1);
     }
 
     #[test]
