@@ -128,120 +128,39 @@ mod tests {
         assert_eq!(disagreeing(&current, &[earlier]), vec![1]);
     }
 
-    /// A drive along the x axis past [`DRIVE_ROCKS`], one station a metre, seeing the rocks
-    /// within 8 m (bearings ±0.02 rad, exact range order), with one wrong association
-    /// injected: from x = 12 m on, rock `A` is hidden and rock `B`, 1.5 m from it, is
-    /// reported as landmark `A`. Each station's matches go through [`disagreeing`] against
-    /// the stations before when `check`; an undone match makes `B` a landmark of its own.
-    /// Returns the map's unsound relations against the truth and the stations it rejected.
+    /// The test drive (`test_drive`) with its wrong association from station 12 on. Each
+    /// station's matches go through [`disagreeing`] against the stations before when `check`;
+    /// an undone match makes `B` a landmark of its own (100). Returns the map's unsound
+    /// relations against the truth and the stations it rejected.
     fn drive_with_a_wrong_association(check: bool) -> (usize, usize) {
-        use qrm_core::calculus::Calculus;
+        use super::super::test_drive::{seen, unsound, A, B, STATIONS};
         use qrm_core::edc::Edc;
-        use qrm_core::geometry::Point;
-        use qrm_core::map::{Hypergraph, Sighting};
-        use qrm_core::measurement::{Bearing, RangeOrder, StationView};
-        const A: usize = 0;
-        const B: usize = 1;
-        let rocks: Vec<Point> = DRIVE_ROCKS.iter().map(|&[x, y]| Point::new(x, y)).collect();
-        // Landmark ids are rock indices, but for `B` once its match to `A` is undone.
+        use qrm_core::map::Hypergraph;
         let mut b_landmark = A as LandmarkId;
-        let rock_of = |l: LandmarkId, b_landmark: LandmarkId| {
-            if l == b_landmark && l != A as LandmarkId {
-                B
-            } else {
-                l as usize
-            }
-        };
         let mut map = Hypergraph::<Edc>::new();
         let mut history: Vec<Frame> = Vec::new();
         let mut rejected = 0;
-        for step in 0..=24 {
-            let station = Point::new(f64::from(step), 0.0);
-            let hidden = if step >= 12 { A } else { B };
-            let mut seen: Vec<usize> = (0..rocks.len())
-                .filter(|&r| r != hidden && rocks[r].distance(station) <= 8.0)
-                .collect();
-            seen.sort_by(|&i, &j| {
-                rocks[i]
-                    .distance(station)
-                    .total_cmp(&rocks[j].distance(station))
-            });
-            let label = |r: usize, b_landmark: LandmarkId| {
-                if r == B {
-                    b_landmark
-                } else {
-                    r as LandmarkId
-                }
-            };
-            let placed = |r: usize| Placed {
-                point: [rocks[r].x - station.x, rocks[r].y - station.y],
-                radius: 0.3,
-            };
+        for step in 0..STATIONS {
+            let seen = seen(step, 12);
             if check {
-                let matched: Vec<(LandmarkId, Placed)> = seen
-                    .iter()
-                    .map(|&r| (label(r, b_landmark), placed(r)))
-                    .collect();
-                if disagreeing(&matched, &history).contains(&b_landmark) {
+                let label = |r: usize| if r == B { b_landmark } else { r as LandmarkId };
+                if disagreeing(&seen.frame(label).landmarks, &history).contains(&b_landmark) {
                     b_landmark = 100;
                 }
             }
-            let view = StationView::new(
-                seen.iter()
-                    .map(|&r| Bearing {
-                        angle: (rocks[r].y - station.y).atan2(rocks[r].x - station.x),
-                        uncertainty: 0.02,
-                    })
-                    .collect(),
-                RangeOrder::total(&(0..seen.len()).collect::<Vec<_>>()).unwrap(),
-            )
-            .unwrap();
-            let sightings: Vec<Sighting> = seen
-                .iter()
-                .enumerate()
-                .map(|(k, &r)| Sighting::new(k, label(r, b_landmark)))
-                .collect();
-            let batch = map.observations(&view, &sightings);
-            if map.fuse(&batch).is_err() {
+            let label = |r: usize| if r == B { b_landmark } else { r as LandmarkId };
+            if map
+                .fuse(&map.observations(&seen.view, &seen.sightings(label)))
+                .is_err()
+            {
                 rejected += 1;
                 continue;
             }
-            history.push(Frame {
-                accumulated: false,
-                departed: Vec::new(),
-                landmarks: seen
-                    .iter()
-                    .map(|&r| (label(r, b_landmark), placed(r)))
-                    .collect(),
-            });
+            history.push(seen.frame(label));
         }
-        let truth = |a: LandmarkId, b: LandmarkId, c: LandmarkId| {
-            let p = |l| rocks[rock_of(l, b_landmark)];
-            Edc::classify(p(a), p(b), p(c))
-        };
-        let metrics = qrm_core::metrics::evaluate(&map, truth, map.len());
-        (metrics.unsound_relations, rejected)
+        let rock_of = |l: LandmarkId| if l == 100 { B } else { l as usize };
+        (unsound(&map, rock_of), rejected)
     }
-
-    /// Rocks `A` and `B` (1.5 m apart), then rocks on both sides of the drive.
-    const DRIVE_ROCKS: [[f64; 2]; 16] = [
-        [12.0, 3.0],
-        [13.2, 3.9],
-        [2.0, 4.0],
-        [4.0, -3.0],
-        [6.0, 5.0],
-        [8.0, -5.0],
-        [9.0, 2.0],
-        [11.0, -2.0],
-        [14.0, 6.5],
-        [15.0, -4.0],
-        [17.0, -3.0],
-        [18.0, 5.0],
-        [20.0, 1.5],
-        [22.0, -4.0],
-        [23.0, 4.0],
-        [5.0, 1.5],
-    ];
 
     #[test]
     fn a_wrong_association_injected_into_a_drive_is_undone_and_the_map_stays_sound() {

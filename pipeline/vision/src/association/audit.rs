@@ -134,136 +134,74 @@ fn components(n: usize, edges: &[(usize, usize)]) -> Vec<usize> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_drive::{seen, unsound, A, B, STATIONS};
     use super::*;
-    use crate::association::Placed;
-    use qrm_core::calculus::Calculus;
     use qrm_core::edc::Edc;
-    use qrm_core::geometry::Point;
-    use qrm_core::map::{Journal, Sighting};
-    use qrm_core::measurement::{Bearing, RangeOrder, StationView};
+    use qrm_core::map::Journal;
     use std::sync::Arc;
 
-    /// Rocks `A` and `B` (1.5 m apart, indices 0 and 1), then rocks on both sides of a drive
-    /// along the x axis.
-    const ROCKS: [[f64; 2]; 16] = [
-        [12.0, 3.0],
-        [13.2, 3.9],
-        [2.0, 4.0],
-        [4.0, -3.0],
-        [6.0, 5.0],
-        [8.0, -5.0],
-        [9.0, 2.0],
-        [11.0, -2.0],
-        [14.0, 6.5],
-        [15.0, -4.0],
-        [17.0, -3.0],
-        [18.0, 5.0],
-        [20.0, 1.5],
-        [22.0, -4.0],
-        [23.0, 4.0],
-        [5.0, 1.5],
-    ];
-
-    /// The drive, one station a metre, seeing the rocks within 8 m (bearings ±0.02 rad, exact
-    /// range order, placements 0.3 m), with wrong associations injected: from x = `wrong`
-    /// on, rock `A` is hidden and rock `B` is fused as landmark `A`, with no check. Returns
-    /// the journal and each fused station's frame.
+    /// The test drive with rock `B` fused as landmark `A` from station `wrong` on, unchecked:
+    /// the journal and each station's frame.
     fn drive(wrong: usize) -> (Journal, Vec<(usize, Frame)>) {
-        let rocks: Vec<Point> = ROCKS.iter().map(|&[x, y]| Point::new(x, y)).collect();
         let mut map = qrm_core::map::Hypergraph::<Edc>::new();
         let mut journal = Journal::default();
         let mut frames = Vec::new();
-        for step in 0..=24 {
-            let station = Point::new(step as f64, 0.0);
-            let hidden = if step >= wrong { 0 } else { 1 };
-            let mut seen: Vec<usize> = (0..rocks.len())
-                .filter(|&r| r != hidden && rocks[r].distance(station) <= 8.0)
-                .collect();
-            seen.sort_by(|&i, &j| {
-                rocks[i]
-                    .distance(station)
-                    .total_cmp(&rocks[j].distance(station))
-            });
-            // Rock B is landmark A: the injected association.
-            let label = |r: usize| if r == 1 { 0 } else { r as LandmarkId };
-            let view = Arc::new(
-                StationView::new(
-                    seen.iter()
-                        .map(|&r| Bearing {
-                            angle: (rocks[r].y - station.y).atan2(rocks[r].x - station.x),
-                            uncertainty: 0.02,
-                        })
-                        .collect(),
-                    RangeOrder::total(&(0..seen.len()).collect::<Vec<_>>()).unwrap(),
-                )
-                .unwrap(),
-            );
-            let sightings: Vec<Sighting> = seen
-                .iter()
-                .enumerate()
-                .map(|(k, &r)| Sighting::new(k, label(r)))
-                .collect();
-            map.fuse(&map.observations(&view, &sightings))
+        let label = |r: usize| {
+            if r == B {
+                A as LandmarkId
+            } else {
+                r as LandmarkId
+            }
+        };
+        for step in 0..STATIONS {
+            let seen = seen(step, wrong);
+            let sightings = seen.sightings(label);
+            map.fuse(&map.observations(&seen.view, &sightings))
                 .expect("the injected association is quiet");
-            journal.record(step, view, &sightings);
-            let placed = |r: usize| Placed {
-                point: [rocks[r].x - station.x, rocks[r].y - station.y],
-                radius: 0.3,
-            };
-            frames.push((
-                step,
-                Frame {
-                    accumulated: false,
-                    departed: Vec::new(),
-                    landmarks: seen.iter().map(|&r| (label(r), placed(r))).collect(),
-                },
-            ));
+            journal.record(step, Arc::new(seen.view.clone()), &sightings);
+            frames.push((step, seen.frame(label)));
         }
         (journal, frames)
     }
 
-    /// The unsound relations of `map`, landmark `l` being rock `l` but for `b_landmark`, rock B.
-    fn unsound(map: &qrm_core::map::Hypergraph<Edc>, b_landmark: Option<LandmarkId>) -> usize {
-        let p = |l: LandmarkId| {
-            let r = if Some(l) == b_landmark { 1 } else { l as usize };
-            Point::new(ROCKS[r][0], ROCKS[r][1])
-        };
-        let truth = |a, b, c| Edc::classify(p(a), p(b), p(c));
-        qrm_core::metrics::evaluate(map, truth, map.len()).unsound_relations
+    fn sightings_of(landmark: LandmarkId, frames: &[(usize, Frame)]) -> Vec<(usize, &Frame)> {
+        frames
+            .iter()
+            .filter(|(_, f)| f.landmarks.iter().any(|m| m.0 == landmark))
+            .map(|(s, f)| (*s, f))
+            .collect()
     }
 
     #[test]
     fn a_landmark_fused_from_two_rocks_is_split_and_the_map_made_sound_again() {
         let (journal, frames) = drive(12);
         let mixed = journal.replay::<Edc>(|_, l| Some(l));
-        assert!(unsound(&mixed.map, None) > 0, "the injection is not quiet");
-        let sightings: Vec<(usize, &Frame)> = frames
-            .iter()
-            .filter(|(_, f)| f.landmarks.iter().any(|m| m.0 == 0))
-            .map(|(s, f)| (*s, f))
-            .collect();
-        let regrouping = regroup(0, &sightings).expect("the sightings disagree");
+        assert!(
+            unsound(&mixed.map, |l| l as usize) > 0,
+            "the injection is not quiet"
+        );
+        let regrouping = regroup(0, &sightings_of(0, &frames)).expect("the sightings disagree");
         // Rock A was seen up to station 11, rock B from 12 on, within 8 m.
         let a: Vec<usize> = (5..12).collect();
         let b: Vec<usize> = (12..=20).collect();
         assert_eq!(regrouping.groups, vec![b.clone(), a]);
         assert!(regrouping.retired.is_empty());
         let split = journal.replay::<Edc>(|station, l| {
-            Some(if l == 0 && b.contains(&station) { 100 } else { l })
+            Some(if l == 0 && b.contains(&station) {
+                100
+            } else {
+                l
+            })
         });
         assert!(split.rejected.is_empty());
-        assert_eq!(unsound(&split.map, Some(100)), 0);
+        let rock_of = |l: LandmarkId| if l == 100 { B } else { l as usize };
+        assert_eq!(unsound(&split.map, rock_of), 0);
     }
 
     #[test]
     fn sightings_of_one_rock_stay_together() {
         let (_, frames) = drive(usize::MAX);
-        let sightings: Vec<(usize, &Frame)> = frames
-            .iter()
-            .filter(|(_, f)| f.landmarks.iter().any(|m| m.0 == 0))
-            .map(|(s, f)| (*s, f))
-            .collect();
-        assert_eq!(regroup(0, &sightings), None);
+        assert_eq!(regroup(0, &sightings_of(0, &frames)), None);
     }
 
     #[test]

@@ -41,6 +41,8 @@ mod recency;
 mod registration;
 mod significance;
 pub mod sketch;
+#[cfg(test)]
+pub(crate) mod test_drive;
 
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
 pub use recency::LastSeen;
@@ -842,7 +844,10 @@ mod tests {
             left(vec![(&first, loose.clone()), (&second, loose.clone())]),
             2
         );
-        let significant = Registration { nfa: 0.001, ..loose };
+        let significant = Registration {
+            nfa: 0.001,
+            ..loose
+        };
         assert_eq!(left(vec![(&first, significant)]), 1);
     }
 

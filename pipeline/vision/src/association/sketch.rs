@@ -77,6 +77,12 @@ impl Sketch {
         }
     }
 
+    /// Forgets where `landmark` is: its sightings were found to show more than one rock.
+    pub fn forget(&mut self, landmark: LandmarkId) {
+        self.landmarks.retain(|s| s.landmark != landmark);
+        self.departed.retain(|s| s.landmark != landmark);
+    }
+
     /// Brings station `station`'s fused sightings (placed around it) into the sketch: the
     /// rigid motion that its landmarks already in the sketch fit moves them there (pairs
     /// that do not fit it are left out of the fit; a placement away from its landmark's

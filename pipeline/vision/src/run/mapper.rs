@@ -2,20 +2,24 @@
 //! (000 §VI-C) turn detections into measurements, fused into the map (000 §VI-B); held-back
 //! observations are retried after every station.
 
-use super::record::{Association, DetectionRecord, MetricsRecord, RangeRecord, StationRecord};
+use super::record::{
+    Association, DetectionRecord, MetricsRecord, RangeRecord, SplitRecord, StationRecord,
+};
 use super::selection;
+use crate::association::audit::{regroup, Regrouping};
 use crate::association::{
     agreement, associate, reconsider, sketch, AssociationSettings, Decision, Evidence, Frame,
-    Gallery, LastSeen, Placed, Sketch,
+    Gallery, LastSeen, Placed, Profile, Sketch,
 };
 use crate::calib::Calibration;
 use crate::detection::{Detection, Separation};
 use crate::ranging::{self, PrimaryEye, Ranged, SensorModel};
 use qrm_core::calculus::Calculus;
-use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
+use qrm_core::map::{Hypergraph, Journal, LandmarkId, Sighting};
 use qrm_core::measurement::{Bearing, StationView};
 use qrm_core::neighborhood::{estimate, RngEstimate};
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// One station's detections, ready for mapping.
@@ -57,7 +61,7 @@ pub struct Sighted {
 #[derive(Clone, Debug, PartialEq)]
 struct HeldBack {
     station: usize,
-    view: StationView,
+    view: Arc<StationView>,
     /// Position in `view`, and index among the station's detections.
     detection: usize,
     primary_index: usize,
@@ -70,6 +74,8 @@ struct HeldBack {
 /// The map being built and what association needs to remember.
 pub struct Mapper<C: Calculus> {
     pub map: Hypergraph<C>,
+    /// Every fusion into `map`, to rebuild it without a landmark's wrong sightings.
+    journal: Journal,
     pub gallery: Gallery,
     calib: Calibration,
     sensor: SensorModel,
@@ -100,6 +106,7 @@ impl<C: Calculus> Mapper<C> {
     pub fn new(calib: Calibration, sensor: SensorModel, association: AssociationSettings) -> Self {
         Mapper {
             map: Hypergraph::new(),
+            journal: Journal::default(),
             gallery: Gallery::default(),
             calib,
             sensor,
@@ -226,6 +233,7 @@ impl<C: Calculus> Mapper<C> {
         let view = selection::view_of(&ranged, &associated.usable);
         record.order = asserted_order(&view, &associated.usable);
         self.fuse_station(&mut record, associated, view);
+        self.audit(&mut record);
         record.fusion.resolved_held_back = self.retry_held_back(&mut record);
         record.seconds.map = start.elapsed().as_secs_f64();
         let start = Instant::now();
@@ -293,6 +301,7 @@ impl<C: Calculus> Mapper<C> {
         associated: Associated,
         view: StationView,
     ) {
+        let view = Arc::new(view);
         // With fewer than three landmarks there is no triple to measure, but the sightings
         // still place and describe the landmarks for association at later stations.
         let batch = if associated.fused.len() >= 3 {
@@ -309,6 +318,8 @@ impl<C: Calculus> Mapper<C> {
                 // Without a triple, the landmarks decided here enter the map unrelated.
                 let decided: Vec<_> = associated.fused.iter().map(|s| s.landmark).collect();
                 self.map.add_landmarks(&decided);
+                self.journal
+                    .record(record.index, Arc::clone(&view), &associated.fused);
                 if report.relations_tightened > 0 || self.map.len() != before {
                     self.revision += 1;
                 }
@@ -372,6 +383,129 @@ impl<C: Calculus> Mapper<C> {
         });
     }
 
+    /// Splits every landmark fused at this station whose placement here an earlier station
+    /// contradicts ([`agreement::witness`]) into the rocks its sightings show ([`regroup`]),
+    /// and rebuilds the map without the mixture. Association already held back the matches
+    /// that recent stations contradict; what is left are sightings whose disagreement only
+    /// a station that shares enough landmarks with both can tell.
+    fn audit(&mut self, record: &mut StationRecord) {
+        let Some((current, earlier)) = self
+            .sighted
+            .split_last()
+            .filter(|(current, _)| current.station == record.index)
+        else {
+            return;
+        };
+        let contradicted: Vec<LandmarkId> = current
+            .frame
+            .landmarks
+            .iter()
+            .map(|m| m.0)
+            .filter(|&l| {
+                earlier
+                    .iter()
+                    .any(|s| agreement::witness(&s.frame, &current.frame, l) == Some(false))
+            })
+            .collect();
+        for landmark in contradicted {
+            let sightings: Vec<(usize, &Frame)> = self
+                .sighted
+                .iter()
+                .filter(|s| s.frame.landmarks.iter().any(|m| m.0 == landmark))
+                .map(|s| (s.station, &s.frame))
+                .collect();
+            if let Some(regrouping) = regroup(landmark, &sightings) {
+                self.split(record, &regrouping);
+            }
+        }
+    }
+
+    /// Gives each further group of `regrouping` a landmark of its own, takes the retired
+    /// sightings out, and rebuilds the map from the journal so that the relations the mixed
+    /// landmark brought, and what path consistency derived from them, are reverted.
+    fn split(&mut self, record: &mut StationRecord, regrouping: &Regrouping) {
+        let landmark = regrouping.landmark;
+        let new: Vec<LandmarkId> = (1..regrouping.groups.len())
+            .map(|_| {
+                self.next_landmark += 1;
+                self.next_landmark - 1
+            })
+            .collect();
+        let relabel = |station: usize, l: LandmarkId| -> Option<LandmarkId> {
+            if l != landmark {
+                return Some(l);
+            }
+            if regrouping.retired.contains(&station) {
+                return None;
+            }
+            Some(
+                regrouping.groups[1..]
+                    .iter()
+                    .zip(&new)
+                    .find(|(group, _)| group.contains(&station))
+                    .map_or(landmark, |(_, &n)| n),
+            )
+        };
+        let replay = self.journal.replay::<C>(relabel);
+        self.map = replay.map;
+        self.journal = replay.journal;
+        for station in replay.rejected {
+            record.warnings.push(format!(
+                "station {station} no longer fits the map once landmark {landmark} was split, \
+                 and was taken out of it"
+            ));
+        }
+        for s in &mut self.sighted {
+            let station = s.station;
+            s.frame.landmarks = s
+                .frame
+                .landmarks
+                .iter()
+                .filter_map(|&(l, p)| Some((relabel(station, l)?, p)))
+                .collect();
+            s.bearings = s
+                .bearings
+                .iter()
+                .filter_map(|(&l, &b)| Some((relabel(station, l)?, b)))
+                .collect();
+        }
+        self.sightings = self
+            .sightings
+            .iter()
+            .filter_map(|&(station, detection, l)| Some((station, detection, relabel(station, l)?)))
+            .collect();
+        for item in &mut self.held {
+            let station = item.station;
+            item.decided = item
+                .decided
+                .iter()
+                .filter_map(|s| Some(Sighting::new(s.position, relabel(station, s.landmark)?)))
+                .collect();
+        }
+        if let Some(profile) = self.gallery.profile(landmark).cloned() {
+            for &n in &new {
+                self.gallery.profiles.push(Profile {
+                    landmark: n,
+                    ..profile.clone()
+                });
+            }
+        }
+        for (group, &n) in regrouping.groups[1..].iter().zip(&new) {
+            if let Some(&last) = group.iter().max() {
+                self.last_seen.record(n, last);
+            }
+        }
+        // Where the sketch put the landmark averages both rocks' placements.
+        self.sketch.forget(landmark);
+        self.revision += 1;
+        record.fusion.splits.push(SplitRecord {
+            landmark,
+            new_landmarks: new,
+            groups: regrouping.groups.clone(),
+            retired: regrouping.retired.clone(),
+        });
+    }
+
     /// The stations within the sketch's window before `index`, oldest first. A frame older
     /// than that shows rocks the rover has left behind: on sparse-large seed 3, after 47
     /// stations that fused too few landmarks to push a new frame, station 51 registered six
@@ -384,7 +518,12 @@ impl<C: Calculus> Mapper<C> {
     }
 
     /// Keeps the station's undecided detections to be tried again on a tighter map.
-    fn hold_back(&mut self, record: &mut StationRecord, associated: Associated, view: StationView) {
+    fn hold_back(
+        &mut self,
+        record: &mut StationRecord,
+        associated: Associated,
+        view: Arc<StationView>,
+    ) {
         for (position, candidates) in associated.held {
             let primary_index = associated.usable[position];
             record.detections[primary_index].association = Association::HeldBack {
@@ -392,7 +531,7 @@ impl<C: Calculus> Mapper<C> {
             };
             self.held.push(HeldBack {
                 station: record.index,
-                view: view.clone(),
+                view: Arc::clone(&view),
                 detection: position,
                 primary_index,
                 candidates,
@@ -446,6 +585,12 @@ impl<C: Calculus> Mapper<C> {
             );
             match self.map.fuse(&batch) {
                 Ok(_) => {
+                    self.journal.record_added(
+                        item.station,
+                        Arc::clone(&item.view),
+                        Sighting::new(item.detection, landmark),
+                        &item.decided,
+                    );
                     self.revision += 1;
                     self.next_landmark += 1;
                     self.gallery.observe(
@@ -616,4 +761,100 @@ fn asserted_order(view: &StationView, usable: &[usize]) -> Vec<(usize, usize)> {
         .filter(|&(a, b)| view.order.is_nearer(a, b))
         .map(|(a, b)| (usable[a], usable[b]))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::association::test_drive::{seen, unsound, A, B, STATIONS};
+    use crate::detection::Appearance;
+    use qrm_core::edc::Edc;
+
+    /// The test drive fused through a mapper with rock `B` taken for landmark `A` at station
+    /// 12, as association would if nothing checked it, the audit run after every station.
+    /// Later stations take `B` for whatever landmark its last sighting now has, as tracking
+    /// would.
+    #[test]
+    fn a_landmark_found_to_mix_two_rocks_is_split_and_the_map_rebuilt_sound() {
+        let calib = Calibration::parse(
+            include_str!("../../../../calib/default.toml"),
+            "default.toml",
+        )
+        .expect("the default calibration");
+        let mut mapper = Mapper::<Edc>::new(
+            calib,
+            SensorModel::default(),
+            AssociationSettings::default(),
+        );
+        mapper.next_landmark = 100;
+        let mut b_landmark = A as LandmarkId;
+        let looks = Appearance {
+            colour: [0.4, 0.3, 0.3],
+            brightness: 1.0,
+            texture: 0.1,
+            dark_fraction: 0.2,
+        };
+        let mut splits = Vec::new();
+        for step in 0..STATIONS {
+            let seen = seen(step, 12);
+            let label = |r: usize| if r == B { b_landmark } else { r as LandmarkId };
+            let fused = seen.sightings(label);
+            let view = Arc::new(seen.view.clone());
+            let batch = mapper.map.observations(&view, &fused);
+            mapper
+                .map
+                .fuse(&batch)
+                .expect("the wrong association is quiet");
+            mapper.journal.record(step, view, &fused);
+            for s in &fused {
+                mapper.sightings.push((step, s.position, s.landmark));
+                mapper.gallery.observe(s.landmark, looks.clone(), None);
+                mapper.last_seen.record(s.landmark, step);
+            }
+            mapper.sighted.push(Sighted {
+                station: step,
+                bearings: fused
+                    .iter()
+                    .map(|s| (s.landmark, seen.view.bearings[s.position]))
+                    .collect(),
+                frame: seen.frame(label),
+            });
+            let mut record = StationRecord {
+                index: step,
+                ..StationRecord::default()
+            };
+            mapper.audit(&mut record);
+            splits.extend(record.fusion.splits);
+            if let Some(k) = seen.rocks.iter().position(|&r| r == B) {
+                b_landmark = mapper
+                    .sightings
+                    .iter()
+                    .find(|s| s.0 == step && s.1 == k)
+                    .map_or(b_landmark, |s| s.2);
+            }
+        }
+        assert_eq!(splits.len(), 1, "{splits:?}");
+        assert_eq!(splits[0].new_landmarks, vec![100]);
+        // Every landmark's sightings now show one rock; rock A's keep landmark A.
+        let mut rock_of: BTreeMap<LandmarkId, usize> = BTreeMap::new();
+        for &(station, position, l) in &mapper.sightings {
+            let r = seen(station, 12).rocks[position];
+            assert_eq!(
+                *rock_of.entry(l).or_insert(r),
+                r,
+                "landmark {l} mixes rocks"
+            );
+        }
+        assert_eq!(rock_of[&(A as LandmarkId)], A);
+        assert_eq!(unsound(&mapper.map, |l| rock_of[&l]), 0);
+        // Frames, gallery and journal follow the split.
+        for s in &mapper.sighted {
+            for &(l, _) in &s.frame.landmarks {
+                assert!(mapper.gallery.profile(l).is_some());
+                assert!(mapper.map.contains(l));
+            }
+        }
+        let replayed = mapper.journal.replay::<Edc>(|_, l| Some(l));
+        assert_eq!(replayed.map, mapper.map);
+    }
 }

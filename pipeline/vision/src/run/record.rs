@@ -2,6 +2,7 @@
 //! rerun recording, the summary) is written from. Plain data, serialised as JSON; the field
 //! meanings are documented in `docs/RUN.md`.
 
+use qrm_core::map::LandmarkId;
 use serde::{Deserialize, Serialize};
 
 /// Everything the run learned from one station's panorama(s).
@@ -135,6 +136,22 @@ pub struct FusionRecord {
     pub resolved_held_back: usize,
     /// Why the map rejected the panorama, if it did.
     pub contradiction: Option<String>,
+    /// Landmarks found, once this panorama was fused, to mix rocks, and split.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub splits: Vec<SplitRecord>,
+}
+
+/// A landmark whose sightings at two stations disagreed on where it is, split into the rocks
+/// its sightings show (`association::audit`): the stations of `groups[0]` keep `landmark`,
+/// those of each further group saw `new_landmarks` (in order), and the sightings of `retired`
+/// stations left the map. `landmarks.json` has the sightings as split; a station's record
+/// keeps the decision made when it was mapped.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SplitRecord {
+    pub landmark: LandmarkId,
+    pub new_landmarks: Vec<LandmarkId>,
+    pub groups: Vec<Vec<usize>>,
+    pub retired: Vec<usize>,
 }
 
 /// The map after a panorama.

@@ -26,6 +26,9 @@ pub struct RunSummary {
     pub fully_constrained_fraction: f64,
     /// Panoramas the map rejected as contradicting it.
     pub contradictions: usize,
+    /// Landmarks found to mix rocks and split after the fact (`association::audit`).
+    #[serde(default)]
+    pub landmarks_split: usize,
     /// Observations held back at their station, resolved later, and still pending at the end.
     pub held_back: usize,
     pub resolved_held_back: usize,
@@ -106,6 +109,7 @@ impl RunSummary {
                 .iter()
                 .filter(|r| r.fusion.contradiction.is_some())
                 .count(),
+            landmarks_split: records.iter().map(|r| r.fusion.splits.len()).sum(),
             held_back: records
                 .iter()
                 .flat_map(|r| &r.detections)
@@ -168,8 +172,9 @@ impl fmt::Display for RunSummary {
         )?;
         writeln!(
             f,
-            "contradictions: {}; held back: {} ({} resolved later, {} given up, {} pending)",
+            "contradictions: {}; landmarks split: {}; held back: {} ({} resolved later, {} given up, {} pending)",
             self.contradictions,
+            self.landmarks_split,
             self.held_back,
             self.resolved_held_back,
             self.expired_held_back,
