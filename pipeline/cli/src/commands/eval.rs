@@ -223,8 +223,8 @@ pub fn print_report(e: &Evaluation) {
     );
     let a = &e.association;
     println!(
-        "  association: accuracy {:.3} ({} of {} sightings), {} landmarks, {} rocks duplicated, {} landmarks mixed, {} sightings of false detections",
-        a.accuracy, a.correct_sightings, a.sightings, a.landmarks, a.duplicated_rocks, a.mixed_landmarks, a.unmatched_sightings
+        "  association: accuracy {:.3} ({} of {} sightings), purity {:.3} (false detections aside), {} landmarks, {} rocks duplicated, {} landmarks mixed, {} sightings of false detections",
+        a.accuracy, a.correct_sightings, a.sightings, a.purity, a.landmarks, a.duplicated_rocks, a.mixed_landmarks, a.unmatched_sightings
     );
     println!(
         "  reached the map: {:.1} % of detections matched to rocks; {} of the {} rocks detected at 3 or more stations have a landmark ({:.1} %)",

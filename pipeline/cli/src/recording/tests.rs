@@ -88,6 +88,7 @@ fn station(index: usize) -> StationRecord {
             relations_tightened: index,
             resolved_held_back: index % 2,
             contradiction: (index == 5).then(|| "triple (1, 2, 3) emptied".to_string()),
+            splits: Vec::new(),
         },
         metrics: MetricsRecord {
             landmarks: 3 + index,

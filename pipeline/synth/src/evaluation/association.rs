@@ -68,6 +68,7 @@ pub(super) fn score(
     }
     a.duplicated_rocks = rocks.landmarks_of_rock.values().filter(|&&n| n > 1).count();
     a.accuracy = ratio(a.correct_sightings, a.sightings);
+    a.purity = ratio(a.correct_sightings, a.sightings - a.unmatched_sightings);
     a.fused_fraction = ratio(a.correct_sightings, matched.len());
     let mut stations_of_rock: HashMap<u32, BTreeSet<usize>> = HashMap::new();
     for (&(station, _), &rock) in matched {
@@ -138,6 +139,9 @@ mod tests {
             }]
         );
         assert_eq!((score.correct_sightings, score.unmatched_sightings), (5, 1));
+        // 7 sightings: the false detection lowers accuracy, not purity.
+        assert!((score.accuracy - 5.0 / 7.0).abs() < 1e-12);
+        assert!((score.purity - 5.0 / 6.0).abs() < 1e-12);
         assert_eq!((rocks.majority(0), rocks.majority(1)), (Some(7), Some(8)));
         // 5 of the 6 detections of rocks reached their rock's landmark; rock 7 alone was
         // detected at three stations, and landmark 0 stands for it.

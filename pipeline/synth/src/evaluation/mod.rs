@@ -99,6 +99,9 @@ pub struct AssociationScore {
     /// Sightings of the rock their landmark stands for (its majority rock).
     pub correct_sightings: usize,
     pub accuracy: f64,
+    /// Correct sightings over the sightings that show a rock: the landmarks' purity (issues 13
+    /// and 14), which false detections do not lower.
+    pub purity: f64,
     /// Rocks with more than one landmark, and landmarks whose sightings span several rocks.
     pub duplicated_rocks: usize,
     pub mixed_landmarks: usize,
