@@ -1,7 +1,7 @@
 //! The qualitative map `M = (P, E)` of 000 §VI-A: landmarks and one edge per unordered triple
 //! storing `{p_i p_j : p_k, p_j p_k : p_i, p_k p_i : p_j}`.
 
-use super::index::{choose3, locate, rank};
+use super::index::{choose3, locate, rank, unrank};
 use super::kernel::Kernel;
 use super::update::LandmarkId;
 use crate::calculus::{Calculus, RelationSet};
@@ -16,10 +16,17 @@ use std::marker::PhantomData;
 /// landmarks) lives at `C(k,3) + C(j,2) + i` in one flat vector and holds the raw bitsets of
 /// `[ij:k, jk:i, ki:j]` (12 bytes per edge; 300 landmarks ≈ 4.5 M edges ≈ 53 MB). Edges of a
 /// new landmark are appended and start at `C::universe()`.
+///
+/// Most edges never leave the universe: on the 1 000-rock drive, 146 196 of 25.8 M (0.6 %)
+/// hold anything, 105 359 of them derived by path consistency for landmarks never seen
+/// together. The ranks of those that do are kept ([`Hypergraph::constrained`]), so that
+/// queries over what the map knows (its metrics, the RNG estimate) visit them only.
 pub struct Hypergraph<C: Calculus> {
     pub(super) landmarks: Vec<LandmarkId>,
     pub(super) index: HashMap<LandmarkId, usize>,
     pub(super) edges: Vec<[u32; 3]>,
+    /// Ranks of the edges that left the universe, each once, in no particular order.
+    pub(super) constrained: Vec<usize>,
     calculus: PhantomData<fn() -> C>,
 }
 
@@ -30,6 +37,7 @@ impl<C: Calculus> Hypergraph<C> {
             landmarks: Vec::new(),
             index: HashMap::new(),
             edges: Vec::new(),
+            constrained: Vec::new(),
             calculus: PhantomData,
         }
     }
@@ -59,21 +67,45 @@ impl<C: Calculus> Hypergraph<C> {
 
     /// Open states summed over every relation of every edge (003 §1.5.1's first metric).
     pub fn open_states(&self) -> usize {
-        self.triples()
-            .map(|(_, _, _, r)| r.iter().map(|s| s.len()).sum::<usize>())
-            .sum()
+        let universe = C::universe().len();
+        let closed: usize = self
+            .constrained
+            .iter()
+            .map(|&r| {
+                self.edges[r]
+                    .iter()
+                    .map(|&s| universe - RelationSet::from_bits(s).len())
+                    .sum::<usize>()
+            })
+            .sum();
+        3 * universe * self.edges.len() - closed
     }
 
     /// Edges whose three relations are each a single state.
     pub fn fully_constrained_triples(&self) -> usize {
-        self.triples()
-            .filter(|(_, _, _, r)| r.iter().all(|s| s.len() == 1))
+        self.constrained
+            .iter()
+            .filter(|&&r| {
+                self.edges[r]
+                    .iter()
+                    .all(|&s| RelationSet::from_bits(s).len() == 1)
+            })
             .count()
+    }
+
+    /// Positions `[i, j, k]` (`i < j < k` in [`Hypergraph::landmarks`]) of every edge that
+    /// holds something other than the universe, in storage order; every other edge holds
+    /// `C::universe()` in each relation.
+    pub fn constrained(&self) -> Vec<[usize; 3]> {
+        let mut ranks = self.constrained.clone();
+        ranks.sort_unstable();
+        ranks.into_iter().map(unrank).collect()
     }
 
     /// Heap bytes held by the map (edges, landmark list and id index).
     pub fn heap_bytes(&self) -> usize {
         self.edges.capacity() * std::mem::size_of::<[u32; 3]>()
+            + self.constrained.capacity() * std::mem::size_of::<usize>()
             + self.landmarks.capacity() * std::mem::size_of::<LandmarkId>()
             + self.index.capacity()
                 * (std::mem::size_of::<(LandmarkId, usize)>() + std::mem::size_of::<u64>())
@@ -134,6 +166,13 @@ impl<C: Calculus> Hypergraph<C> {
             self.index.remove(&id);
         }
         self.edges.truncate(choose3(count));
+        let edges = self.edges.len();
+        self.constrained.retain(|&r| r < edges);
+    }
+
+    /// Records that edge `rank`, at the universe until now, holds something.
+    pub(super) fn mark_constrained(&mut self, rank: usize) {
+        self.constrained.push(rank);
     }
 }
 
@@ -149,6 +188,7 @@ impl<C: Calculus> Clone for Hypergraph<C> {
             landmarks: self.landmarks.clone(),
             index: self.index.clone(),
             edges: self.edges.clone(),
+            constrained: self.constrained.clone(),
             calculus: PhantomData,
         }
     }

@@ -124,6 +124,9 @@ impl<C: Calculus> Hypergraph<C> {
                     set.bits()
                 };
             }
+            if map.edges[rank] == [C::universe().bits(); 3] && stored != map.edges[rank] {
+                map.mark_constrained(rank);
+            }
             map.edges[rank] = stored;
         }
         map.check_closed()?;

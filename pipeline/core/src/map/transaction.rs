@@ -116,8 +116,12 @@ impl<'m, C: Calculus> Transaction<'m, C> {
 
     /// Finishes the update and returns its statistics.
     pub fn commit(mut self) -> UpdateReport {
+        let universe = [C::universe().bits(); 3];
         for &(rank, old) in &self.undo {
             let new = self.map.edges[rank];
+            if old == universe && new != universe {
+                self.map.mark_constrained(rank);
+            }
             let tightened = (0..3).filter(|&s| new[s] != old[s]).count();
             self.report.relations_tightened += tightened;
             self.report.triples_changed += usize::from(tightened > 0);
