@@ -111,7 +111,11 @@ fn recorders(args: &RunArgs) -> Result<Vec<Box<dyn Recorder>>> {
 /// The map's RNG estimate `rng` over a graph layout, for the recorders and rng.png.
 fn rng_drawing(map: &Hypergraph<Edc>, rng: &RngEstimate) -> RngDrawing {
     let ids = map.landmarks();
-    let index = |id: u32| ids.iter().position(|&l| l == id).expect("edge of the map");
+    // Every edge's ends by position: a search of the landmark list per edge is O(edges ×
+    // landmarks), and a long drive's estimate has 10⁵ edges among hundreds of landmarks.
+    let position: std::collections::HashMap<u32, usize> =
+        ids.iter().enumerate().map(|(i, &l)| (l, i)).collect();
+    let index = |id: u32| position[&id];
     let layout = spring_layout(
         ids.len(),
         &rng.edges

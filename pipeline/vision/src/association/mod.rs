@@ -216,14 +216,7 @@ pub fn associate<C: Calculus>(
     let candidates = placed_near(candidates, &registrations, &placed);
     drop_inconsistent_anchors(map, view, &mut anchors);
     let anchored: Vec<Sighting> = anchors.iter().map(|a| Sighting::new(a.0, a.1)).collect();
-    // A look-alike in a recent frame is held as a candidate without a test only while it was
-    // fused lately: when the rover enters ground where it shares too few landmarks to
-    // register, every rock in view would otherwise be held for the look-alikes of the last 25
-    // stations until the sketch starts again (`sparse-large` seed 7, stations 87–111:
-    // nothing fused, 14 rocks never mapped; with this, 94.5 % of the rocks seen from three
-    // stations mapped instead of 78 %, no landmark mixed).
-    let recent =
-        |l: LandmarkId| lately(l) && frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
+    let recent = |l: LandmarkId| frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
     (0..n)
         .into_par_iter()
         .map(|i| match anchored.iter().find(|a| a.position == i) {
@@ -763,22 +756,6 @@ mod tests {
                 .map(|(l, &p)| (l as LandmarkId, at(p)))
                 .collect(),
         }
-    }
-
-    #[test]
-    fn a_look_alike_not_fused_lately_holds_nothing_back() {
-        // Three rocks where a recent frame has three look-alike landmarks elsewhere: too few
-        // to register. While those landmarks were fused lately the detections wait for the
-        // map to tell; once the rover has gone without fusing them, they are new rocks.
-        let seen = station(&FIELD[..3]);
-        let recent = frame(&FIELD[3..6]);
-        let held = associate_after(&seen, std::slice::from_ref(&recent), &|_| true);
-        assert!(
-            held.iter().all(|d| matches!(d, Decision::HeldBack(_))),
-            "{held:?}"
-        );
-        let new = associate_after(&seen, &[recent], &|_| false);
-        assert_eq!(new, vec![Decision::New; 3]);
     }
 
     #[test]
