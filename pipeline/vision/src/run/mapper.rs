@@ -490,6 +490,10 @@ impl<C: Calculus> Mapper<C> {
                 });
             }
         }
+        // A landmark all of whose sightings were retired is no landmark any more.
+        if !self.sightings.iter().any(|s| s.2 == landmark) {
+            self.gallery.profiles.retain(|p| p.landmark != landmark);
+        }
         for (group, &n) in regrouping.groups[1..].iter().zip(&new) {
             if let Some(&last) = group.iter().max() {
                 self.last_seen.record(n, last);
