@@ -102,7 +102,8 @@ impl<C: Calculus> Hypergraph<C> {
         ranks.into_iter().map(unrank).collect()
     }
 
-    /// Heap bytes held by the map (edges, landmark list and id index).
+    /// Heap bytes held by the map (edges, the ranks of the constrained ones, landmark list and
+    /// id index).
     pub fn heap_bytes(&self) -> usize {
         self.edges.capacity() * std::mem::size_of::<[u32; 3]>()
             + self.constrained.capacity() * std::mem::size_of::<usize>()
