@@ -30,13 +30,7 @@ pub fn disagreeing<'f>(
     let mut out: Vec<LandmarkId> = earlier
         .into_iter()
         .flat_map(|frame| {
-            let shared: Vec<(LandmarkId, (Placed, Placed))> = current
-                .iter()
-                .filter_map(|&(l, p)| {
-                    let q = frame.landmarks.iter().find(|m| m.0 == l)?.1;
-                    Some((l, (p, q)))
-                })
-                .collect();
+            let shared = shared(current, frame);
             let pairs: Vec<(Placed, Placed)> = shared.iter().map(|s| s.1).collect();
             let agree = Motion::agreed(&pairs, FEWEST_OTHERS);
             shared
@@ -52,16 +46,20 @@ pub fn disagreeing<'f>(
     out
 }
 
+/// The landmarks of `current` that `frame` places too, with both placements.
+fn shared(current: &[(LandmarkId, Placed)], frame: &Frame) -> Vec<(LandmarkId, (Placed, Placed))> {
+    current
+        .iter()
+        .filter_map(|&(l, p)| Some((l, (p, frame.landmarks.iter().find(|m| m.0 == l)?.1))))
+        .collect()
+}
+
 /// What the two stations' frames `a` and `b` say of landmark `l`, both placing it: `Some(true)`
 /// when the motion between them that at least [`FEWEST_OTHERS`] other shared landmarks agree
 /// on brings its two placements together, `Some(false)` when it does not, `None` when too few
 /// others are shared to say.
 pub fn witness(a: &Frame, b: &Frame, l: LandmarkId) -> Option<bool> {
-    let pairs: Vec<(LandmarkId, (Placed, Placed))> = a
-        .landmarks
-        .iter()
-        .filter_map(|&(m, p)| Some((m, (p, b.landmarks.iter().find(|n| n.0 == m)?.1))))
-        .collect();
+    let pairs = shared(&a.landmarks, b);
     let k = pairs.iter().position(|s| s.0 == l)?;
     let placements: Vec<(Placed, Placed)> = pairs.iter().map(|s| s.1).collect();
     let agree = Motion::agreed(&placements, FEWEST_OTHERS)?;
