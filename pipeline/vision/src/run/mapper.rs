@@ -439,8 +439,10 @@ impl<C: Calculus> Mapper<C> {
                 return None;
             }
             Some(
-                regrouping.groups[1..]
+                regrouping
+                    .groups
                     .iter()
+                    .skip(1)
                     .zip(&new)
                     .find(|(group, _)| group.contains(&station))
                     .map_or(landmark, |(_, &n)| n),
@@ -494,7 +496,7 @@ impl<C: Calculus> Mapper<C> {
         if !self.sightings.iter().any(|s| s.2 == landmark) {
             self.gallery.profiles.retain(|p| p.landmark != landmark);
         }
-        for (group, &n) in regrouping.groups[1..].iter().zip(&new) {
+        for (group, &n) in regrouping.groups.iter().skip(1).zip(&new) {
             if let Some(&last) = group.iter().max() {
                 self.last_seen.record(n, last);
             }
@@ -860,5 +862,74 @@ mod tests {
         }
         let replayed = mapper.journal.replay::<Edc>(|_, l| Some(l));
         assert_eq!(replayed.map, mapper.map);
+    }
+
+    /// A regrouping may retire every sighting (one group that disagrees with itself): the
+    /// landmark then leaves the map, its gallery and the frames, and nothing else changes.
+    #[test]
+    fn a_landmark_whose_every_sighting_is_retired_leaves_the_map() {
+        let calib = Calibration::parse(
+            include_str!("../../../../calib/default.toml"),
+            "default.toml",
+        )
+        .expect("the default calibration");
+        let mut mapper = Mapper::<Edc>::new(
+            calib,
+            SensorModel::default(),
+            AssociationSettings::default(),
+        );
+        let looks = Appearance {
+            colour: [0.4, 0.3, 0.3],
+            brightness: 1.0,
+            texture: 0.1,
+            dark_fraction: 0.2,
+        };
+        let stations = 6;
+        for step in 0..stations {
+            let seen = seen(step, usize::MAX);
+            let fused = seen.sightings(|r| r as LandmarkId);
+            let view = Arc::new(seen.view.clone());
+            let batch = mapper.map.observations(&view, &fused);
+            mapper.map.fuse(&batch).expect("true associations fit");
+            mapper.journal.record(step, view, &fused);
+            for s in &fused {
+                mapper.sightings.push((step, s.position, s.landmark));
+                mapper.gallery.observe(s.landmark, looks.clone(), None);
+            }
+            mapper.sighted.push(Sighted {
+                station: step,
+                bearings: fused
+                    .iter()
+                    .map(|s| (s.landmark, seen.view.bearings[s.position]))
+                    .collect(),
+                frame: seen.frame(|r| r as LandmarkId),
+            });
+        }
+        let landmark = A as LandmarkId;
+        let retired: Vec<usize> = (0..stations)
+            .filter(|&step| seen(step, usize::MAX).rocks.contains(&A))
+            .collect();
+        assert!(!retired.is_empty());
+        let mut record = StationRecord::default();
+        mapper.split(
+            &mut record,
+            &Regrouping {
+                landmark,
+                groups: Vec::new(),
+                retired,
+            },
+        );
+        assert!(mapper.sightings.iter().all(|s| s.2 != landmark));
+        assert!(mapper.gallery.profile(landmark).is_none());
+        assert!(!mapper.map.contains(landmark));
+        assert!(mapper.sighted.iter().all(|s| s
+            .frame
+            .landmarks
+            .iter()
+            .all(|&(l, _)| l != landmark)));
+        assert_eq!(
+            record.fusion.splits[0].new_landmarks,
+            Vec::<LandmarkId>::new()
+        );
     }
 }
