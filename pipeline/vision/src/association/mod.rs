@@ -368,6 +368,12 @@ fn believed<'f>(
         {
             Vec::new()
         }
+        // Nor is a station's only registration of any size whose fit chance explains: as many
+        // fits as tight are expected from the hypotheses tried. (Seen on the 1 000-rock drive
+        // with unranged detections counted in the eye's direction, an experiment not kept:
+        // station 12's only registration, 7 pairs against the sketch at NFA 1.5 × 10⁴, paired
+        // six landmarks with the wrong rocks, 1 983 unsound relations.)
+        [(_, registration)] if registration.nfa >= 1.0 => Vec::new(),
         _ => registrations,
     }
 }
@@ -849,6 +855,32 @@ mod tests {
             ..loose
         };
         assert_eq!(left(vec![(&first, significant)]), 1);
+    }
+
+    /// A lone registration of many pairs needs no small NFA, but one that chance explains
+    /// (NFA ≥ 1: as many fits as tight expected from the hypotheses tried) is not believed.
+    #[test]
+    fn a_lone_registration_that_chance_explains_is_not_believed_whatever_its_size() {
+        let (only, other) = (frame(&FIELD), frame(&FIELD[..1]));
+        let large = |nfa: f64| Registration {
+            pairs: (0..6).map(|l| (l, l as LandmarkId)).collect(),
+            motion: [1.0, 0.0, 0.0, 0.0],
+            nfa,
+        };
+        let left = |registration: Registration| {
+            believed(vec![(&only, registration)], &[only.clone(), other.clone()]).len()
+        };
+        assert_eq!(left(large(0.5)), 1);
+        assert_eq!(left(large(1.5e4)), 0);
+        assert_eq!(
+            believed(
+                vec![(&only, large(1.5e4)), (&other, large(0.5))],
+                &[only.clone(), other.clone()]
+            )
+            .len(),
+            2,
+            "beside another registration it is judged with it"
+        );
     }
 
     #[test]
