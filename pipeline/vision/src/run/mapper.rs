@@ -772,9 +772,56 @@ fn asserted_order(view: &StationView, usable: &[usize]) -> Vec<(usize, usize)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::association::test_drive::{seen, unsound, A, B, STATIONS};
+    use crate::association::test_drive::{seen, unsound, Seen, A, B, STATIONS};
     use crate::detection::Appearance;
     use qrm_core::edc::Edc;
+
+    fn test_mapper() -> Mapper<Edc> {
+        let calib = Calibration::parse(
+            include_str!("../../../../calib/default.toml"),
+            "default.toml",
+        )
+        .expect("the default calibration");
+        Mapper::new(
+            calib,
+            SensorModel::default(),
+            AssociationSettings::default(),
+        )
+    }
+
+    /// Fuses station `step` of the test drive as `label` associates its rocks, with nothing
+    /// checking the association, and remembers it as `Mapper::remember` would.
+    fn fuse_unchecked(
+        mapper: &mut Mapper<Edc>,
+        step: usize,
+        seen: &Seen,
+        label: impl Fn(usize) -> LandmarkId + Copy,
+    ) {
+        let looks = Appearance {
+            colour: [0.4, 0.3, 0.3],
+            brightness: 1.0,
+            texture: 0.1,
+            dark_fraction: 0.2,
+        };
+        let fused = seen.sightings(label);
+        let view = Arc::new(seen.view.clone());
+        let batch = mapper.map.observations(&view, &fused);
+        mapper.map.fuse(&batch).expect("a quiet association fits");
+        mapper.journal.record(step, view, &fused);
+        for s in &fused {
+            mapper.sightings.push((step, s.position, s.landmark));
+            mapper.gallery.observe(s.landmark, looks.clone(), None);
+            mapper.last_seen.record(s.landmark, step);
+        }
+        mapper.sighted.push(Sighted {
+            station: step,
+            bearings: fused
+                .iter()
+                .map(|s| (s.landmark, seen.view.bearings[s.position]))
+                .collect(),
+            frame: seen.frame(label),
+        });
+    }
 
     /// The test drive fused through a mapper with rock `B` taken for landmark `A` at station
     /// 12, as association would if nothing checked it, the audit run after every station.
@@ -782,49 +829,14 @@ mod tests {
     /// would.
     #[test]
     fn a_landmark_found_to_mix_two_rocks_is_split_and_the_map_rebuilt_sound() {
-        let calib = Calibration::parse(
-            include_str!("../../../../calib/default.toml"),
-            "default.toml",
-        )
-        .expect("the default calibration");
-        let mut mapper = Mapper::<Edc>::new(
-            calib,
-            SensorModel::default(),
-            AssociationSettings::default(),
-        );
+        let mut mapper = test_mapper();
         mapper.next_landmark = 100;
         let mut b_landmark = A as LandmarkId;
-        let looks = Appearance {
-            colour: [0.4, 0.3, 0.3],
-            brightness: 1.0,
-            texture: 0.1,
-            dark_fraction: 0.2,
-        };
         let mut splits = Vec::new();
         for step in 0..STATIONS {
             let seen = seen(step, 12);
             let label = |r: usize| if r == B { b_landmark } else { r as LandmarkId };
-            let fused = seen.sightings(label);
-            let view = Arc::new(seen.view.clone());
-            let batch = mapper.map.observations(&view, &fused);
-            mapper
-                .map
-                .fuse(&batch)
-                .expect("the wrong association is quiet");
-            mapper.journal.record(step, view, &fused);
-            for s in &fused {
-                mapper.sightings.push((step, s.position, s.landmark));
-                mapper.gallery.observe(s.landmark, looks.clone(), None);
-                mapper.last_seen.record(s.landmark, step);
-            }
-            mapper.sighted.push(Sighted {
-                station: step,
-                bearings: fused
-                    .iter()
-                    .map(|s| (s.landmark, seen.view.bearings[s.position]))
-                    .collect(),
-                frame: seen.frame(label),
-            });
+            fuse_unchecked(&mut mapper, step, &seen, label);
             let mut record = StationRecord {
                 index: step,
                 ..StationRecord::default()
@@ -868,41 +880,11 @@ mod tests {
     /// landmark then leaves the map, its gallery and the frames, and nothing else changes.
     #[test]
     fn a_landmark_whose_every_sighting_is_retired_leaves_the_map() {
-        let calib = Calibration::parse(
-            include_str!("../../../../calib/default.toml"),
-            "default.toml",
-        )
-        .expect("the default calibration");
-        let mut mapper = Mapper::<Edc>::new(
-            calib,
-            SensorModel::default(),
-            AssociationSettings::default(),
-        );
-        let looks = Appearance {
-            colour: [0.4, 0.3, 0.3],
-            brightness: 1.0,
-            texture: 0.1,
-            dark_fraction: 0.2,
-        };
+        let mut mapper = test_mapper();
         let stations = 6;
         for step in 0..stations {
-            let seen = seen(step, usize::MAX);
-            let fused = seen.sightings(|r| r as LandmarkId);
-            let view = Arc::new(seen.view.clone());
-            let batch = mapper.map.observations(&view, &fused);
-            mapper.map.fuse(&batch).expect("true associations fit");
-            mapper.journal.record(step, view, &fused);
-            for s in &fused {
-                mapper.sightings.push((step, s.position, s.landmark));
-                mapper.gallery.observe(s.landmark, looks.clone(), None);
-            }
-            mapper.sighted.push(Sighted {
-                station: step,
-                bearings: fused
-                    .iter()
-                    .map(|s| (s.landmark, seen.view.bearings[s.position]))
-                    .collect(),
-                frame: seen.frame(|r| r as LandmarkId),
+            fuse_unchecked(&mut mapper, step, &seen(step, usize::MAX), |r| {
+                r as LandmarkId
             });
         }
         let landmark = A as LandmarkId;
