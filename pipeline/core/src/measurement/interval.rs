@@ -128,26 +128,35 @@ pub fn by_intervals(
     let (others, start) = ratio_box(nearer);
     let mut kept = known;
     let mut pending: [RelationSet; 3] = std::array::from_fn(|k| candidates[k].difference(known[k]));
-    let mut stack = vec![(start, 0u32)];
-    while let Some((log_ratios, depth)) = stack.pop() {
+    // Each box carries the regions its ancestors could not rule out: an enclosure over a
+    // sub-box lies within the enclosure over the box, so what a box excludes stays excluded
+    // below it, and only the relations with a region left need their enclosures.
+    // A box is carried with its ratios (the exponentials of its log-ratio bounds).
+    let ratios = start.map(|r| Interval::new(r.lo.exp(), r.hi.exp()));
+    let mut stack = vec![(start, ratios, 0u32, pending)];
+    while let Some((log_ratios, ratios, depth, inherited)) = stack.pop() {
         if pending.iter().all(|p| p.is_empty()) {
             break;
+        }
+        let open: [RelationSet; 3] = std::array::from_fn(|k| inherited[k].intersection(pending[k]));
+        if open.iter().all(|p| p.is_empty()) {
+            continue;
         }
         // Ranges over the box, scaled so that the largest is at most 1 (signs do not change,
         // and every quantity stays O(1) for the rounding slack).
         let mut ranges = [Interval::new(1.0, 1.0); 3];
         for (slot, &i) in others.iter().enumerate() {
-            ranges[i] = Interval::new(log_ratios[slot].lo.exp(), log_ratios[slot].hi.exp());
+            ranges[i] = ratios[slot];
         }
         if nearer.iter().any(|&(p, q)| ranges[p].lo >= ranges[q].hi) {
             continue;
         }
         let largest = ranges.iter().map(|r| r.hi).fold(0.0, f64::max);
         let ranges = ranges.map(|r| Interval::new(r.lo / largest, r.hi / largest));
-        let mut alive = false;
-        for k in 0..3 {
+        let mut alive = [RelationSet::EMPTY; 3];
+        for k in (0..3).filter(|&k| !open[k].is_empty()) {
             let values = enclosures(&ranges, &turns, [k, (k + 1) % 3, (k + 2) % 3]);
-            for region in pending[k].iter() {
+            for region in open[k].iter() {
                 let signs = SIGNS[region as usize - 1];
                 if values.iter().zip(signs).any(|(v, s)| v.excludes_sign(s)) {
                     continue;
@@ -156,21 +165,29 @@ pub fn by_intervals(
                     kept[k] = kept[k].with(region);
                     pending[k] = pending[k].without(region);
                 } else {
-                    alive = true;
+                    alive[k] = alive[k].with(region);
                 }
             }
         }
-        if alive {
+        if alive.iter().any(|a| !a.is_empty()) {
             let widths = log_ratios.map(|r| r.hi - r.lo);
             let axis = usize::from(widths[1] > widths[0]);
             let middle = 0.5 * (log_ratios[axis].lo + log_ratios[axis].hi);
-            for half in [
-                Interval::new(log_ratios[axis].lo, middle),
-                Interval::new(middle, log_ratios[axis].hi),
+            let at_middle = middle.exp();
+            for (half, ratio) in [
+                (
+                    Interval::new(log_ratios[axis].lo, middle),
+                    Interval::new(ratios[axis].lo, at_middle),
+                ),
+                (
+                    Interval::new(middle, log_ratios[axis].hi),
+                    Interval::new(at_middle, ratios[axis].hi),
+                ),
             ] {
-                let mut next = log_ratios;
+                let (mut next, mut next_ratios) = (log_ratios, ratios);
                 next[axis] = half;
-                stack.push((next, depth + 1));
+                next_ratios[axis] = ratio;
+                stack.push((next, next_ratios, depth + 1, alive));
             }
         }
     }
