@@ -6,6 +6,9 @@
 use anyhow::{Context, Result};
 use image::imageops::{self, FilterType};
 use image::RgbImage;
+use kornia_image::{Image, ImageSize};
+use kornia_imgproc::interpolation::InterpolationMode;
+use kornia_imgproc::resize::resize_fast_rgb;
 use qrm_atomic_file::{OutputSet, Temporary};
 use qrm_core::map::LandmarkId;
 use qrm_plot::{
@@ -223,8 +226,7 @@ fn annotate(
     let shown = if scale == 1.0 {
         image.clone()
     } else {
-        let scaled = |v: u32| ((f64::from(v) * scale).round() as u32).max(1);
-        imageops::thumbnail(image, scaled(image.width()), scaled(image.height()))
+        resized(image, scale)
     };
     let marks: Vec<Mark> = record
         .detections
@@ -258,6 +260,26 @@ fn annotate(
     )
     .with_context(|| format!("cannot write {}", path.display()))?;
     Ok(temporary)
+}
+
+/// `image` scaled by `scale` (a power of two), bilinear: halving averages each 2 × 2 block.
+/// kornia's SIMD resize, since `image`'s area filter took 7 % of a marsyard run's CPU time.
+fn resized(image: &RgbImage, scale: f64) -> RgbImage {
+    let scaled = |v: u32| ((f64::from(v) * scale).round() as u32).max(1);
+    let (width, height) = (scaled(image.width()), scaled(image.height()));
+    let size = |width: u32, height: u32| ImageSize {
+        width: width as usize,
+        height: height as usize,
+    };
+    Image::<u8, 3>::new(size(image.width(), image.height()), image.as_raw().clone())
+        .and_then(|src| {
+            let mut dst = Image::<u8, 3>::from_size_val(size(width, height), 0)?;
+            resize_fast_rgb(&src, &mut dst, InterpolationMode::Bilinear)?;
+            Ok(dst)
+        })
+        .ok()
+        .and_then(|dst| RgbImage::from_raw(width, height, dst.as_slice().to_vec()))
+        .expect("a decoded panorama and a positive size")
 }
 
 /// The power of two that brings a panorama `width` pixels wide to more than
