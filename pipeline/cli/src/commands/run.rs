@@ -8,7 +8,7 @@ use crate::recording::{McapRecorder, Recorder, RngDrawing};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use image::RgbImage;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use qrm_atomic_file::OutputSet;
 use qrm_core::edc::Edc;
 use qrm_core::map::Hypergraph;
@@ -19,7 +19,7 @@ use qrm_vision::calib::Calibration;
 use qrm_vision::detection::Channels;
 use qrm_vision::run::beliefs::{bearing_sd, run_beliefs};
 use qrm_vision::run::{
-    detect_survey, map_stations, BeliefsSummary, Mapper, Progress, RunSettings, RunSummary, Stage,
+    traverse_survey, BeliefsSummary, Mapper, Progress, RunError, RunSettings, RunSummary, Stage,
     StationRecord,
 };
 use qrm_vision::survey::{read_image, Survey};
@@ -97,6 +97,10 @@ impl From<ChannelsArg> for Channels {
 /// The seed of 002's particles in `--mode probabilistic`: a run's beliefs are reproducible.
 const BELIEF_SEED: u64 = 1;
 
+/// The recorders of a run, and the RNG drawing of the map's latest revision (see
+/// [`record_station`]).
+type Recording = (Vec<Box<dyn Recorder>>, Option<(u64, RngDrawing)>);
+
 /// The recorders of the run: run.mcap always, run.rrd on request.
 fn recorders(args: &RunArgs) -> Result<Vec<Box<dyn Recorder>>> {
     let mcap: Box<dyn Recorder> = Box::new(McapRecorder::create(args.out.join("run.mcap"))?);
@@ -138,17 +142,26 @@ fn rng_drawing(map: &Hypergraph<Edc>, rng: &RngEstimate) -> RngDrawing {
 /// `done`, from the thread that did the station.
 pub type Listener = dyn Fn(&str, usize, usize) + Send + Sync;
 
-/// Progress bars on the terminal, one per stage, or a caller's [`Listener`] instead; warnings
-/// printed above the bars and kept for the tally at the end. Quiet: neither bars nor warning
-/// lines.
+/// Progress bars on the terminal, one per stage (detection and mapping run at once, so both
+/// may show), or a caller's [`Listener`] instead; warnings printed above the bars and kept for
+/// the tally at the end. Quiet: neither bars nor warning lines.
 #[derive(Default)]
 struct Bars {
-    current: Mutex<Option<ProgressBar>>,
+    terminal: MultiProgress,
+    bars: Mutex<Vec<(Stage, ProgressBar)>>,
     warnings: Mutex<Vec<String>>,
     quiet: bool,
     listener: Option<Box<Listener>>,
-    /// The listener's stage and count: (stage, done, total).
-    position: Mutex<(&'static str, usize, usize)>,
+    /// The listener's count of each stage begun: (stage, done, total).
+    positions: Mutex<Vec<(Stage, usize, usize)>>,
+}
+
+/// A stage's name for the bars and the listener.
+fn stage_name(stage: Stage) -> &'static str {
+    match stage {
+        Stage::Detect => "detect",
+        Stage::Map => "map",
+    }
 }
 
 impl Bars {
@@ -181,28 +194,20 @@ impl Bars {
             .map(|(_, n, example)| (n, example))
             .collect()
     }
-
-    fn with_bar(&self, f: impl FnOnce(&ProgressBar)) {
-        if let Some(bar) = self.current.lock().expect("no panics hold it").as_ref() {
-            f(bar);
-        }
-    }
 }
 
 impl Progress for Bars {
     fn begin(&self, stage: Stage, stations: usize) {
-        let what = match stage {
-            Stage::Detect => "detect",
-            Stage::Map => "map",
-        };
+        let what = stage_name(stage);
         if let Some(listener) = &self.listener {
-            *self.position.lock().expect("no panics hold it") = (what, 0, stations);
+            let mut positions = self.positions.lock().expect("no panics hold it");
+            positions.push((stage, 0, stations));
             listener(what, 0, stations);
         }
         if self.quiet {
             return;
         }
-        let bar = ProgressBar::new(stations as u64);
+        let bar = self.terminal.add(ProgressBar::new(stations as u64));
         bar.set_style(
             ProgressStyle::with_template(&format!(
                 "{{spinner}} {what:<9} [{{bar:40}}] {{pos}}/{{len}} ({{elapsed}}, eta {{eta}})"
@@ -210,23 +215,32 @@ impl Progress for Bars {
             .expect("static template")
             .progress_chars("=> "),
         );
-        *self.current.lock().expect("no panics hold it") = Some(bar);
+        self.bars
+            .lock()
+            .expect("no panics hold it")
+            .push((stage, bar));
     }
 
-    fn advance(&self) {
+    fn advance(&self, stage: Stage) {
         if let Some(listener) = &self.listener {
             // Called under the lock, so that counts reach the listener in order: a slow
-            // listener slows the stage's workers, which wait here.
-            let mut position = self.position.lock().expect("no panics hold it");
-            position.1 += 1;
-            listener(position.0, position.1, position.2);
+            // listener slows the stages' threads, which wait here.
+            let mut positions = self.positions.lock().expect("no panics hold it");
+            if let Some(position) = positions.iter_mut().find(|p| p.0 == stage) {
+                position.1 += 1;
+                listener(stage_name(stage), position.1, position.2);
+            }
         }
-        self.with_bar(|bar| bar.inc(1));
+        let bars = self.bars.lock().expect("no panics hold it");
+        if let Some((_, bar)) = bars.iter().find(|b| b.0 == stage) {
+            bar.inc(1);
+        }
     }
 
-    fn end(&self) {
-        if let Some(bar) = self.current.lock().expect("no panics hold it").take() {
-            bar.finish_and_clear();
+    fn end(&self, stage: Stage) {
+        let mut bars = self.bars.lock().expect("no panics hold it");
+        if let Some(at) = bars.iter().position(|b| b.0 == stage) {
+            bars.remove(at).1.finish_and_clear();
         }
     }
 
@@ -235,13 +249,8 @@ impl Progress for Bars {
             .lock()
             .expect("no panics hold it")
             .push(message.to_string());
-        if self.quiet {
-            return;
-        }
-        let print = || eprintln!("warning: {message}");
-        match self.current.lock().expect("no panics hold it").as_ref() {
-            Some(bar) => bar.suspend(print),
-            None => print(),
+        if !self.quiet {
+            self.terminal.suspend(|| eprintln!("warning: {message}"));
         }
     }
 }
@@ -335,10 +344,29 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
 
     let mut settings = RunSettings::default();
     settings.detector.channels = args.channels.into();
-    let detected = match detect_survey(&survey, &calib, &settings.detector, &bars) {
-        Ok(detected) => detected,
+    let mapper: Mapper<Edc> = Mapper::new(calib, settings.sensor, settings.association);
+    // The output directory and recorders are made once a station could be read.
+    let start = || -> Result<Recording> {
+        std::fs::create_dir_all(&args.out)
+            .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
+        Ok((recorders(args)?, None))
+    };
+    let traversed = traverse_survey(
+        &survey,
+        &calib,
+        &settings.detector,
+        mapper,
+        &bars,
+        start,
+        |(recorders, drawing), record, mapper| {
+            record_station(recorders, drawing, record, mapper, &survey, &calib)
+        },
+    );
+    let (traverse, (recorders, _)) = match traversed {
+        Ok(traversed) => traversed,
+        Err(RunError::Caller(e)) => return Err(e),
         // Quiet runs print no warning lines: the reasons go with the error.
-        Err(e) => {
+        Err(e @ RunError::NothingReadable { .. }) => {
             let reasons: Vec<String> = bars
                 .tally()
                 .into_iter()
@@ -347,22 +375,8 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
                 .collect();
             bail!("{e} ({}); nothing was written", reasons.join("; "))
         }
+        Err(e) => bail!("{e}; nothing was written"),
     };
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
-    let mut recorders = recorders(args)?;
-    let mapper: Mapper<Edc> = Mapper::new(calib, settings.sensor, settings.association);
-    let mut drawing = None;
-    let traverse = map_stations(&detected, mapper, &bars, |record, mapper| {
-        record_station(
-            &mut recorders,
-            &mut drawing,
-            record,
-            mapper,
-            &survey,
-            &calib,
-        )
-    })?;
     let beliefs = match args.mode {
         Mode::Deterministic => None,
         Mode::Probabilistic => {
@@ -413,7 +427,7 @@ pub fn execute(args: &RunArgs, listener: Option<Box<Listener>>) -> Result<Comple
     for recorder in recorders {
         outputs.adopt(recorder.finish()?);
     }
-    let mut summary = traverse.summary(detected.wall_seconds);
+    let mut summary = traverse.summary();
     summary.wall_checks = checks_seconds;
     let beliefs_absent = beliefs.is_none();
     summary.beliefs = beliefs.map(|(_, summary)| summary);

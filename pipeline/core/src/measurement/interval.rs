@@ -134,7 +134,8 @@ pub fn by_intervals(
     // A box is carried with its ratios (the exponentials of its log-ratio bounds).
     let ratios = start.map(|r| Interval::new(r.lo.exp(), r.hi.exp()));
     let mut stack = vec![(start, ratios, 0u32, pending)];
-    let mut boxes = 0u64; let pending0 = pending;
+    let mut boxes = 0u64;
+    let pending0 = pending;
     while let Some((log_ratios, ratios, depth, inherited)) = stack.pop() {
         if pending.iter().all(|p| p.is_empty()) {
             break;
@@ -193,7 +194,20 @@ pub fn by_intervals(
             }
         }
     }
-    if std::env::var_os("QRM_DBG").is_some() { let added: u32 = (0..3).map(|k| kept[k].difference(known[k]).len() as u32).sum(); let p0: u32 = pending0.iter().map(|p| p.len() as u32).sum(); let unc: Vec<f64> = bearings.iter().map(|b| b.uncertainty.to_degrees()).collect(); eprintln!("BOX {boxes} pend {p0} added {added} unc {:.2} {:.2} {:.2}", unc[0], unc[1], unc[2]); }
+    if std::env::var_os("QRM_DBG").is_some() {
+        let added: u32 = (0..3)
+            .map(|k| kept[k].difference(known[k]).len() as u32)
+            .sum();
+        let p0: u32 = pending0.iter().map(|p| p.len() as u32).sum();
+        let unc: Vec<f64> = bearings
+            .iter()
+            .map(|b| b.uncertainty.to_degrees())
+            .collect();
+        eprintln!(
+            "BOX {boxes} pend {p0} added {added} unc {:.2} {:.2} {:.2}",
+            unc[0], unc[1], unc[2]
+        );
+    }
     kept
 }
 

@@ -1,5 +1,5 @@
 //! `pipeline run`: panoramas in, a qualitative map and its RNG out (000 §IV, §VI-C):
-//! [`detect_survey`], then [`map_stations`] with a [`Mapper`].
+//! [`traverse_survey`] with a [`Mapper`].
 
 pub mod beliefs;
 pub mod front_end;
@@ -11,9 +11,7 @@ mod traverse;
 
 pub use mapper::{LandmarkRecord, Mapper, Sighted, StationDetections};
 pub use summary::{BeliefsSummary, RunSummary};
-pub use traverse::{
-    detect_survey, map_stations, Detected, Progress, Quiet, RunError, RunSettings, Stage, Traverse,
-};
+pub use traverse::{traverse_survey, Progress, Quiet, RunError, RunSettings, Stage, Traverse};
 
 pub use record::{
     Association, DetectionRecord, Exclusion, FusionRecord, MetricsRecord, RangeRecord,

@@ -37,7 +37,8 @@ pub struct RunSummary {
     pub expired_held_back: usize,
     pub rng_certain: usize,
     pub rng_uncertain: usize,
-    /// Seconds per stage, summed over stations (decode and detect run on all cores).
+    /// Seconds per stage, summed over stations (decode and detect run on all cores, alongside
+    /// mapping).
     pub seconds_decode: f64,
     pub seconds_detect: f64,
     pub seconds_range: f64,
@@ -49,11 +50,15 @@ pub struct RunSummary {
     pub seconds_metrics: f64,
     #[serde(default)]
     pub seconds_recording: f64,
-    /// Wall time of the parallel decode+detect stage and of the sequential mapping stage.
+    /// Wall time of the parallel decode+detect stage (from the start) and of the sequential
+    /// mapping stage (from the first station mapped). Mapping runs alongside detection, so the
+    /// two overlap, and each stage's per-station seconds above are wall seconds of threads
+    /// that share the cores: their sums exceed the CPU time either stage would take alone.
     pub wall_front_end: f64,
     pub wall_mapping: f64,
-    /// Wall time of writing the outputs (files, recordings, pictures), set by the writer;
-    /// with the checks before the work and the two stages above it accounts for the run.
+    /// Wall time of writing the outputs (files, recordings, pictures), set by the writer; with
+    /// the checks before the work and the span of the two stages above (mapping ends last) it
+    /// accounts for the run.
     #[serde(default)]
     pub wall_outputs: f64,
     /// Wall time of opening the survey and checking the inputs (the truth's fingerprints of
@@ -189,7 +194,7 @@ impl fmt::Display for RunSummary {
         }
         write!(
             f,
-            "time: checks {:.2} s | decode {:.2} s + detect {:.2} s (CPU, {:.2} s wall) | range {:.2} s, associate {:.2} s, map {:.2} s, metrics and RNG {:.2} s, recording {:.2} s ({:.2} s wall) | outputs {:.2} s",
+            "time: checks {:.2} s | decode {:.2} s + detect {:.2} s (threads, {:.2} s wall) | alongside: range {:.2} s, associate {:.2} s, map {:.2} s, metrics and RNG {:.2} s, recording {:.2} s ({:.2} s wall) | outputs {:.2} s",
             self.wall_checks,
             self.seconds_decode,
             self.seconds_detect,
