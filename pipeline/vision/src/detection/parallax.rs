@@ -278,9 +278,14 @@ fn pixel_shifts(
             (xa, xb, ya, yb, 1.0 / ((xb - xa) * (yb - ya)) as f32)
         })
         .collect();
-    let mut costs = vec![0f32; pixels.len() * shifts];
+    // Filled shift by shift, pixel after pixel (written in a pixel's row of shifts, the costs
+    // went to memory one cache line per write), then turned to a row per pixel.
+    let n = pixels.len();
+    let mut by_shift = vec![0f32; n * shifts];
     let stride = rw + 1;
-    let mut integral = vec![0i64; (rh + 1) * stride];
+    // Integral images wrap around u32: a window's sum (at most 765 per pixel) fits, so the
+    // wrapped differences of four corners give it exactly, at half the memory traffic of i64.
+    let mut integral = vec![0u32; (rh + 1) * stride];
     for s in 0..shifts {
         let start = if partner.direction > 0 {
             s
@@ -290,18 +295,32 @@ fn pixel_shifts(
         for y in 0..rh {
             let a = &own[y * rw..(y + 1) * rw];
             let b = &other[y * ow + start..y * ow + start + rw];
-            let mut run = 0;
-            for (x, (p, q)) in a.iter().zip(b).enumerate() {
-                run += i64::from((p - q).abs());
-                integral[(y + 1) * stride + x + 1] = integral[y * stride + x + 1] + run;
+            let (above, below) = integral.split_at_mut((y + 1) * stride);
+            let above = &above[y * stride + 1..];
+            let mut run = 0u32;
+            for (((p, q), up), out) in a.iter().zip(b).zip(above).zip(&mut below[1..stride]) {
+                run = run.wrapping_add(p.abs_diff(*q));
+                *out = up.wrapping_add(run);
             }
         }
-        for (k, &(xa, xb, ya, yb, scale)) in windows.iter().enumerate() {
+        for (&(xa, xb, ya, yb, scale), cost) in windows.iter().zip(&mut by_shift[s * n..]) {
             let sum = integral[yb * stride + xb]
-                - integral[ya * stride + xb]
-                - integral[yb * stride + xa]
-                + integral[ya * stride + xa];
-            costs[k * shifts + s] = sum as f32 * scale;
+                .wrapping_sub(integral[ya * stride + xb])
+                .wrapping_sub(integral[yb * stride + xa])
+                .wrapping_add(integral[ya * stride + xa]);
+            *cost = sum as f32 * scale;
+        }
+    }
+    // Transposed in blocks that stay in cache.
+    const BLOCK: usize = 32;
+    let mut costs = vec![0f32; n * shifts];
+    for k0 in (0..n).step_by(BLOCK) {
+        for s0 in (0..shifts).step_by(BLOCK) {
+            for s in s0..(s0 + BLOCK).min(shifts) {
+                for k in k0..(k0 + BLOCK).min(n) {
+                    costs[k * shifts + s] = by_shift[s * n + k];
+                }
+            }
         }
     }
     costs.chunks_exact(shifts).map(unique_minimum).collect()
