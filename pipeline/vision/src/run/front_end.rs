@@ -126,9 +126,12 @@ pub fn detect_panoramas(
         ));
     }
     // Only the primary (left) panorama's blobs are separated by parallax: the right one's
-    // detections only serve the stereo cue, which separated parts do not take.
-    let primary_detections = detect(primary, right, calib, settings);
-    let right_detections = right.map(|r| detect_right(r, Some(primary), calib, settings));
+    // detections only serve the stereo cue, which separated parts do not take. The two are
+    // detected at once: a rover's navigator detects one station at a time.
+    let (primary_detections, right_detections) = rayon::join(
+        || detect(primary, right, calib, settings),
+        || right.map(|r| detect_right(r, Some(primary), calib, settings)),
+    );
     StationDetections {
         name: name.to_string(),
         files: Vec::new(),
