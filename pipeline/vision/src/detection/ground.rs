@@ -16,6 +16,7 @@
 use crate::calib::Calibration;
 use kornia_image::{Image, ImageSize};
 use kornia_imgproc::filter::gaussian_blur;
+use rayon::prelude::*;
 
 /// Half-size of the matching window, pixels.
 const RADIUS: usize = 2;
@@ -65,26 +66,30 @@ pub(super) fn stances(
     direction: isize,
 ) -> Vec<Stance> {
     let rows = own.len() / width;
-    let (own, other) = (&smoothed(own, width), &smoothed(other, width));
+    let (own, other) = rayon::join(|| smoothed(own, width), || smoothed(other, width));
+    let (own, other) = (&own, &other);
     let mut cost = vec![0f32; own.len()];
     let mut texture = vec![0f32; own.len()];
-    for y in 0..rows {
-        let shift = ground_shift(calib, (top + y) as f64 + 0.5);
-        let (ya, yb) = (y.saturating_sub(RADIUS), (y + RADIUS + 1).min(rows));
-        let (own_band, other_band) = (&own[ya * width..yb * width], &other[ya * width..yb * width]);
-        let out = &mut cost[y * width..(y + 1) * width];
-        out.fill(f32::INFINITY);
-        for s in [shift.floor(), shift.ceil()] {
-            let sums = window_costs(own_band, other_band, width, direction * s as isize);
-            for (o, c) in out.iter_mut().zip(sums) {
-                *o = o.min(c);
+    // Rows in parallel: each is its own windows' sums.
+    cost.par_chunks_mut(width)
+        .zip(texture.par_chunks_mut(width))
+        .enumerate()
+        .for_each(|(y, (out, texture))| {
+            let shift = ground_shift(calib, (top + y) as f64 + 0.5);
+            let (ya, yb) = (y.saturating_sub(RADIUS), (y + RADIUS + 1).min(rows));
+            let (own_band, other_band) =
+                (&own[ya * width..yb * width], &other[ya * width..yb * width]);
+            out.fill(f32::INFINITY);
+            for s in [shift.floor(), shift.ceil()] {
+                let sums = window_costs(own_band, other_band, width, direction * s as isize);
+                for (o, c) in out.iter_mut().zip(sums) {
+                    *o = o.min(c);
+                }
             }
-        }
-        // The same neighbourhood against itself shifted past the tolerance: how much a
-        // mismatch of the shift would cost.
-        let self_cost = window_costs(own_band, own_band, width, SELF_SHIFT);
-        texture[y * width..(y + 1) * width].copy_from_slice(&self_cost);
-    }
+            // The same neighbourhood against itself shifted past the tolerance: how much a
+            // mismatch of the shift would cost.
+            texture.copy_from_slice(&window_costs(own_band, own_band, width, SELF_SHIFT));
+        });
     let threshold = (NOISE_MULTIPLE * median(&cost)).max(MIN_COST);
     cost.into_iter()
         .zip(texture)

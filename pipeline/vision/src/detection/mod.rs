@@ -20,6 +20,7 @@ mod split;
 use crate::calib::Calibration;
 use components::{blob_of, bounds, label_wrapped, Blob};
 use kornia_image::{Image, ImageSize};
+use rayon::prelude::*;
 pub use parallax::{ParallaxRule, Separation};
 use serde::{Deserialize, Serialize};
 
@@ -317,11 +318,13 @@ fn detect_in(
         baseline_m: calib.stereo.baseline_m,
     });
     let blobs = label_wrapped(&mask, w, rows);
+    // Blobs in parallel: a navigator detects one station at a time, and a large rock close by
+    // takes most of a panorama's parallax matching.
     let mut detections: Vec<Detection> = blobs
-        .iter()
+        .par_iter()
         .cloned()
         .enumerate()
-        .flat_map(|(blob, c)| {
+        .flat_map_iter(|(blob, c)| {
             let layers = match &partner {
                 Some(partner) => {
                     let shift = max_shift(&c, top, rows, calib);
@@ -334,7 +337,7 @@ fn detect_in(
             };
             layers.into_iter().map(move |layer| (blob as u32, layer))
         })
-        .flat_map(|(blob, layer)| {
+        .flat_map_iter(|(blob, layer)| {
             let part = layer.part;
             pieces(layer, rule)
                 .into_iter()
