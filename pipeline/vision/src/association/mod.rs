@@ -51,7 +51,7 @@ use registration::{MIN_INLIERS, SIGNIFICANT_NFA};
 pub use sketch::Sketch;
 
 use crate::detection::Appearance;
-use crate::ranging::RangeInterval;
+use crate::ranging::{RangeInterval, Ray};
 use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
 use qrm_core::measurement::StationView;
@@ -140,6 +140,8 @@ pub struct Evidence {
     pub width: Option<RangeInterval>,
     /// Rough position around the station, if its range is bounded well enough.
     pub placed: Option<Placed>,
+    /// The ray it was seen along.
+    pub ray: Ray,
 }
 
 /// One station as association sees it: the bearings and range order of its usable detections,
@@ -151,9 +153,9 @@ pub struct StationEvidence {
     /// Whether the detections' appearance holds colour: without it, an anchor needs more
     /// registrations (`AssociationSettings::min_support_without_colour`).
     pub colour: bool,
-    /// Bearings (radians) of the station's other detections, those mapping does not use
-    /// (touching, doubtful): a landmark seen in one of their directions may be that rock.
-    pub unused_bearings: Vec<f64>,
+    /// The rays of the station's other detections, those mapping does not use (touching,
+    /// doubtful): a landmark seen in one of their directions may be that rock.
+    pub unused: Vec<Ray>,
 }
 
 /// The association decision for one detection.
@@ -185,18 +187,19 @@ pub fn associate<C: Calculus>(
         .iter()
         .map(|e| proposals(e, gallery, settings))
         .collect();
-    // Every detection's bearing, used or not: where the station saw something.
-    let bearings: Vec<f64> = view
-        .bearings
+    // Every detection's ray, used or not: where the station saw something. (A ray, not the
+    // bearing interval's middle: an unranged detection of the left eye alone has its middle
+    // up to 45° from where it was seen.)
+    let seen: Vec<Ray> = evidence
         .iter()
-        .map(|b| b.angle)
-        .chain(station.unused_bearings.iter().copied())
+        .map(|e| e.ray)
+        .chain(station.unused.iter().copied())
         .collect();
-    let mut registrations = registrations(frames, &placed, &candidates, &bearings, lately);
-    let elsewhere: Vec<f64> = (0..n)
+    let mut registrations = registrations(frames, &placed, &candidates, &seen, lately);
+    let elsewhere: Vec<Ray> = (0..n)
         .filter(|&k| placed[k].is_none())
-        .map(|k| view.bearings[k].angle)
-        .chain(station.unused_bearings.iter().copied())
+        .map(|k| evidence[k].ray)
+        .chain(station.unused.iter().copied())
         .collect();
     for (frame, registration) in &mut registrations {
         registration.drop_pairs_seen_elsewhere(frame, &placed, &elsewhere);
@@ -291,7 +294,7 @@ fn registrations<'f>(
     frames: &'f [Frame],
     placed: &[Option<Placed>],
     candidates: &[Vec<(LandmarkId, f64)>],
-    bearings: &[f64],
+    seen: &[Ray],
     lately: &dyn Fn(LandmarkId) -> bool,
 ) -> Vec<(&'f Frame, Registration)> {
     let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
@@ -331,7 +334,7 @@ fn registrations<'f>(
         })
         .filter(|(frame, registration)| {
             registration.pairs.len() > MIN_INLIERS
-                || registration.unseen(frame, bearings, reach) < MIN_UNSEEN
+                || registration.unseen(frame, seen, reach) < MIN_UNSEEN
         })
         // A registration must hold a landmark the rover saw lately: see `recency`.
         .filter(|(_, registration)| registration.pairs.iter().any(|p| lately(p.1)))
@@ -717,6 +720,7 @@ mod tests {
                 appearance: look(),
                 width: None,
                 placed: Some(at(p)),
+                ray: toward(p),
             })
             .collect();
         (
@@ -725,9 +729,17 @@ mod tests {
                 view,
                 detections,
                 colour: true,
-                unused_bearings: Vec::new(),
+                unused: Vec::new(),
             },
         )
+    }
+
+    /// The ray of a detection seen from the station centre towards `p`.
+    fn toward(p: [f64; 2]) -> Ray {
+        Ray {
+            azimuth: p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU),
+            half_baseline: 0.0,
+        }
     }
 
     /// Associates the station against `frames` on an empty map with default settings, every
@@ -936,15 +948,14 @@ mod tests {
                 [p[0] - side * p[1] / r, p[1] + side * p[0] / r]
             })
             .collect();
-        let direction = |p: [f64; 2]| p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU);
         let mut station = station(&offset);
-        station.1.unused_bearings = FIELD[..3].iter().map(|&p| direction(p)).collect();
+        station.1.unused = FIELD[..3].iter().map(|&p| toward(p)).collect();
         let decisions = associate_station(&station, &[frame(&FIELD)]);
         assert!(
             decisions.iter().all(|d| !matches!(d, Decision::Matched(_))),
             "{decisions:?}"
         );
-        station.1.unused_bearings.truncate(2);
+        station.1.unused.truncate(2);
         let decisions = associate_station(&station, &[frame(&FIELD)]);
         for (i, decision) in decisions.iter().enumerate().skip(2) {
             assert_eq!(*decision, Decision::Matched(i as LandmarkId));

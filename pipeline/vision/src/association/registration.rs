@@ -9,6 +9,7 @@
 //! *proposes*: the qualitative test of 000 §VI-C decides (`super::associate`).
 
 use super::significance::Chance;
+use crate::ranging::Ray;
 use qrm_core::map::LandmarkId;
 use qrm_core::measurement::angular_distance;
 
@@ -326,8 +327,9 @@ fn unambiguous(
 
 impl Registration {
     /// Drops the pairs whose landmark, brought back into the current station by the motion,
-    /// lies in a direction nearer to one of the station's detections without a placement
-    /// (bearings `elsewhere`) than to its paired detection's: the landmark may be that rock
+    /// lies in a direction nearer to where one of the station's detections without a placement
+    /// was seen (its ray in `elsewhere`, at the landmark's range) than to its paired
+    /// detection's: the landmark may be that rock
     /// (on half-resolution marsyard seed 4, a rock 1.8 m from a landmark's, seen while the
     /// landmark's own rock was detected but touching another, took the landmark at three
     /// stations: 2 unsound relations).
@@ -335,7 +337,7 @@ impl Registration {
         &mut self,
         frame: &Frame,
         placed: &[Option<Placed>],
-        elsewhere: &[f64],
+        elsewhere: &[Ray],
     ) {
         let direction = |p: [f64; 2]| p[1].atan2(p[0]);
         let motion = self.motion();
@@ -344,16 +346,20 @@ impl Registration {
             else {
                 return true;
             };
-            let back = direction(motion.unapply(q.point));
+            let back = motion.unapply(q.point);
+            let (range, back) = (back[0].hypot(back[1]), direction(back));
             let own = angular_distance(back, direction(p.point));
-            elsewhere.iter().all(|&b| angular_distance(back, b) >= own)
+            elsewhere
+                .iter()
+                .all(|ray| angular_distance(back, ray.direction_at(range)) >= own)
         });
     }
 
     /// The frame's unpaired landmarks that the motion brings within `reach` metres of the
-    /// current station in a direction where the station detected nothing (`bearings`, radians,
-    /// of every detection): rocks the motion says are in view and the panorama does not show.
-    pub fn unseen(&self, frame: &Frame, bearings: &[f64], reach: f64) -> usize {
+    /// current station in a direction where the station detected nothing (`seen`: the ray of
+    /// every detection, at the landmark's range): rocks the motion says are in view and the
+    /// panorama does not show.
+    pub fn unseen(&self, frame: &Frame, seen: &[Ray], reach: f64) -> usize {
         let motion = self.motion();
         frame
             .landmarks
@@ -367,9 +373,8 @@ impl Registration {
                 }
                 let direction = back[1].atan2(back[0]);
                 let window = (q.radius + SLACK_M).atan2(range) + UNSEEN_WINDOW_RAD;
-                bearings
-                    .iter()
-                    .all(|&b| angular_distance(direction, b) > window)
+                seen.iter()
+                    .all(|ray| angular_distance(direction, ray.direction_at(range)) > window)
             })
             .count()
     }
@@ -822,14 +827,18 @@ pub(super) mod tests {
             nfa: 0.0,
         };
         let bearing = |p: [f64; 2]| p[1].atan2(p[0]);
-        let detected: Vec<f64> = FIELD[..4].iter().map(|&p| bearing(p)).collect();
+        let ray = |azimuth: f64| Ray {
+            azimuth,
+            half_baseline: 0.0,
+        };
+        let detected: Vec<Ray> = FIELD[..4].iter().map(|&p| ray(bearing(p))).collect();
         // Rock 3 was detected (unpaired, but seen); rocks 4 (11.3 m) and 5 (6.7 m) were not.
         assert_eq!(registration.unseen(&frame, &detected, 20.0), 2);
         // Beyond the station's reach an absence says nothing.
         assert_eq!(registration.unseen(&frame, &detected, 10.0), 1);
         assert_eq!(registration.unseen(&frame, &detected, 5.0), 0);
         // A detection within a few degrees of rock 5's direction may be it.
-        let near_five = [detected.clone(), vec![bearing(FIELD[5]) + 0.04]].concat();
+        let near_five = [detected.clone(), vec![ray(bearing(FIELD[5]) + 0.04)]].concat();
         assert_eq!(registration.unseen(&frame, &near_five, 20.0), 1);
     }
 
@@ -924,7 +933,25 @@ pub(super) mod tests {
             motion: [1.0, 0.0, 0.0, 0.0],
             nfa: 0.0,
         };
-        registration.drop_pairs_seen_elsewhere(&frame, &placed, &[1f64.atan2(3.0), 2.0]);
+        let ray = |azimuth: f64| Ray {
+            azimuth,
+            half_baseline: 0.0,
+        };
+        let pairs = registration.pairs.clone();
+        registration.drop_pairs_seen_elsewhere(&frame, &placed, &[ray(1f64.atan2(3.0)), ray(2.0)]);
+        assert_eq!(registration.pairs, vec![(1, 11)]);
+        // The left eye alone, half a 0.3 m baseline beside the centre, saw the same rock
+        // asin(0.15 / 3.16) = 2.7° short of the centre's bearing: along its ray the landmark is
+        // where it looked, though the middle of an unranged bearing interval is 45° further on.
+        let left_eye = Ray {
+            azimuth: 1f64.atan2(3.0) - (0.15 / 10f64.sqrt()).asin(),
+            half_baseline: 0.15,
+        };
+        let middle = left_eye.azimuth + std::f64::consts::FRAC_PI_4;
+        registration.pairs = pairs.clone();
+        registration.drop_pairs_seen_elsewhere(&frame, &placed, &[ray(middle), ray(2.0)]);
+        assert_eq!(registration.pairs, pairs, "seen 45° away, it says nothing");
+        registration.drop_pairs_seen_elsewhere(&frame, &placed, &[left_eye, ray(2.0)]);
         assert_eq!(registration.pairs, vec![(1, 11)]);
     }
 

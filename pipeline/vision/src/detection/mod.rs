@@ -20,8 +20,8 @@ mod split;
 use crate::calib::Calibration;
 use components::{blob_of, bounds, label_wrapped, Blob};
 use kornia_image::{Image, ImageSize};
-use rayon::prelude::*;
 pub use parallax::{ParallaxRule, Separation};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Thresholds of the detector. Ratios are relative to the row's median regolith.

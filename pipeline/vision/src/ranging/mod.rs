@@ -73,11 +73,34 @@ pub enum PrimaryEye {
     Left,
 }
 
+/// The ray a detection was seen along: the rock lies somewhere on it, so its bearing from the
+/// station centre depends on how far it is. A detection of the left eye alone is seen from half
+/// a baseline beside the centre, where a rock at range `d` lies `asin(b / 2d)` further round:
+/// unranged, its bearing interval spans every such offset up to a right angle, and the
+/// interval's middle is up to 45° from where the rock was seen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Bearing (radians) from the centre of a rock on the ray far away.
+    pub azimuth: f64,
+    /// Half the baseline (metres) when seen by the left eye alone, else 0.
+    pub half_baseline: f64,
+}
+
+impl Ray {
+    /// Bearing from the station centre of the ray's point `range` metres from the centre.
+    pub fn direction_at(&self, range: f64) -> f64 {
+        let offset = (self.half_baseline / range.max(self.half_baseline)).asin();
+        (self.azimuth + if offset.is_finite() { offset } else { 0.0 }).rem_euclid(TAU)
+    }
+}
+
 /// Bearing and range evidence for one detection of the primary panorama.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ranged {
     /// Bearing from the station centre, radians counter-clockwise.
     pub bearing: Bearing,
+    /// The ray it was seen along: where it was seen, for a rock at a known range.
+    pub ray: Ray,
     /// Centroid column of the matched right-panorama detection.
     pub stereo_column: Option<f64>,
     /// Apparent width, radians of azimuth.
@@ -117,9 +140,10 @@ pub fn observe(
             let right_detection = matches[i].zip(right).map(|(j, r)| &r[j]);
             let stereo = right_detection.map(|r| stereo_cue(d, r, calib, model));
             let (fused, conflict) = fuse([ground, stereo, None]);
-            let bearing = bearing_of(d, right_detection, calib, model, half_baseline, fused);
+            let (bearing, ray) = bearing_of(d, right_detection, calib, model, half_baseline, fused);
             Ranged {
                 bearing,
+                ray,
                 stereo_column: right_detection.map(|r| r.centroid[0]),
                 angular_width,
                 ground,
@@ -280,9 +304,9 @@ fn stereo_cue(
     RangeInterval::new(near, far)
 }
 
-/// Bearing from the station centre. Left eye: α_L = φ − asin(b/2d) and α_R = φ + asin(b/2d),
-/// so a stereo pair gives φ as their mean; a lone left detection gives φ within the offsets
-/// its range interval allows.
+/// Bearing from the station centre, and the ray the detection was seen along. Left eye:
+/// α_L = φ − asin(b/2d) and α_R = φ + asin(b/2d), so a stereo pair gives φ as their mean; a
+/// lone left detection gives φ within the offsets its range interval allows.
 fn bearing_of(
     d: &Detection,
     right: Option<&Detection>,
@@ -290,7 +314,7 @@ fn bearing_of(
     model: &SensorModel,
     half_baseline: f64,
     range: RangeInterval,
-) -> Bearing {
+) -> (Bearing, Ray) {
     let left = calib.azimuth(d.centroid[0]);
     let columns = model.bearing_error_px + model.bearing_error_per_width * apparent_columns(d);
     // Where the rock's centre may lie off the centroid, in columns: within the centroid's
@@ -304,22 +328,36 @@ fn bearing_of(
     );
     let shift = 0.5 * (low + high) * calib.column_sign() * calib.column_width();
     let error = 0.5 * (high - low) * calib.column_width();
-    let (angle, spread) = match right {
+    let (angle, spread, ray_offset) = match right {
         Some(r) => {
             let difference = azimuth_difference(calib.azimuth(r.centroid[0]), left);
-            (left + 0.5 * difference, 0.0)
+            (left + 0.5 * difference, 0.0, 0.0)
         }
         None if half_baseline > 0.0 => {
             let offset = |range: f64| (half_baseline / range.max(half_baseline)).asin();
             let (small, large) = (offset(range.high), offset(range.low.max(half_baseline)));
-            (left + 0.5 * (small + large), 0.5 * (large - small))
+            (
+                left + 0.5 * (small + large),
+                0.5 * (large - small),
+                half_baseline,
+            )
         }
-        None => (left, 0.0),
+        None => (left, 0.0, 0.0),
     };
-    Bearing {
+    let bearing = Bearing {
         angle: (angle + shift).rem_euclid(TAU),
         uncertainty: error + spread,
-    }
+    };
+    let ray = Ray {
+        azimuth: if ray_offset > 0.0 {
+            left + shift
+        } else {
+            angle + shift
+        }
+        .rem_euclid(TAU),
+        half_baseline: ray_offset,
+    };
+    (bearing, ray)
 }
 
 /// Columns, relative to the centroid, between which the centre of the rock a piece belongs to
@@ -421,6 +459,36 @@ mod tests {
     /// Stress member 5's piece: columns 68–74 of a rock whose visible columns are 68–93, the
     /// raised pixels beside it reaching 19 columns further. The bearing keeps the piece's
     /// centroid and takes in the rock's centre; a piece with nothing beyond keeps its bearing.
+    /// The left eye alone, without a range: the bearing interval runs from the eye's direction
+    /// to a right angle beyond, its middle 45° from where the rock was seen; the ray gives the
+    /// rock's bearing from the centre at whatever range it turns out to be.
+    #[test]
+    fn an_unranged_left_detection_is_seen_along_its_ray() {
+        let calib = Calibration::parse(
+            "[image]\nwidth = 2048\nheight = 384\n[azimuth]\ncolumn0_deg = 102.0\n\
+             direction = \"clockwise\"\n[elevation]\nhorizon_row = 150.0\nfocal_px = 326.0\n\
+             [mast]\nheight_m = 1.5\n[stereo]\nbaseline_m = 0.3\n",
+            "test",
+        )
+        .expect("valid");
+        let model = SensorModel::default();
+        let mut piece = blob([68, 222, 74, 228], Separation::Whole);
+        piece.centroid[0] = 71.0;
+        let unranged = RangeInterval::new(0.0, f64::INFINITY);
+        let (bearing, ray) = bearing_of(&piece, None, &calib, &model, 0.15, unranged);
+        let eye = calib.azimuth(71.0);
+        for range in [0.5, 2.0, 10.0, 100.0] {
+            // The left eye sees a rock at `range` asin(b / 2d) short of the centre's bearing.
+            let centre = eye + (0.15f64 / range).asin();
+            assert!(azimuth_difference(ray.direction_at(range), centre).abs() < 1e-12);
+            assert!(azimuth_difference(centre, bearing.angle).abs() <= bearing.uncertainty);
+        }
+        assert!(
+            azimuth_difference(bearing.angle, eye).abs() > 0.7,
+            "{bearing:?}"
+        );
+    }
+
     #[test]
     fn a_piece_with_raised_pixels_beyond_it_is_widened_to_the_rock() {
         let calib = Calibration::parse(
@@ -434,9 +502,9 @@ mod tests {
         let range = RangeInterval::new(4.0, 5.0);
         let mut piece = blob([68, 222, 74, 228], Separation::Whole);
         piece.centroid[0] = 71.3;
-        let alone = bearing_of(&piece, None, &calib, &model, 0.0, range);
+        let alone = bearing_of(&piece, None, &calib, &model, 0.0, range).0;
         piece.beyond_columns = [0, 19];
-        let widened = bearing_of(&piece, None, &calib, &model, 0.0, range);
+        let widened = bearing_of(&piece, None, &calib, &model, 0.0, range).0;
         let holds = |b: Bearing, column: f64| {
             azimuth_difference(calib.azimuth(column), b.angle).abs() <= b.uncertainty
         };
@@ -444,7 +512,10 @@ mod tests {
         assert!(holds(widened, 81.0) && holds(widened, 71.3), "{widened:?}");
         assert!(widened.uncertainty < 3.0 * alone.uncertainty, "{widened:?}");
         piece.beyond_columns = [0, 0];
-        assert_eq!(bearing_of(&piece, None, &calib, &model, 0.0, range), alone);
+        assert_eq!(
+            bearing_of(&piece, None, &calib, &model, 0.0, range).0,
+            alone
+        );
     }
 
     #[test]

@@ -74,12 +74,13 @@ pub(crate) fn station_evidence(
                 appearance: station.primary[i].appearance.clone(),
                 width: width_of(&station.primary[i], &ranged[i], model),
                 placed: placed(&ranged[i]),
+                ray: ranged[i].ray,
             })
             .collect(),
         colour: station.channels == Channels::Colour,
-        unused_bearings: (0..ranged.len())
+        unused: (0..ranged.len())
             .filter(|i| !usable.contains(i))
-            .map(|i| ranged[i].bearing.angle)
+            .map(|i| ranged[i].ray)
             .collect(),
     }
 }
@@ -124,7 +125,7 @@ pub(super) fn view_of(ranged: &[Ranged], usable: &[usize]) -> StationView {
 mod tests {
     use super::*;
     use crate::detection::Appearance;
-    use crate::ranging::PrimaryEye;
+    use crate::ranging::{PrimaryEye, Ray};
 
     fn detection(bbox: [u32; 4], ambiguous: bool, separation: Separation) -> Detection {
         Detection {
@@ -154,6 +155,10 @@ mod tests {
             bearing: Bearing {
                 angle: 1.0,
                 uncertainty,
+            },
+            ray: Ray {
+                azimuth: 1.0,
+                half_baseline: 0.0,
             },
             stereo_column: None,
             angular_width: 0.01,
