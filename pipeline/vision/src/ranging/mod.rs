@@ -456,21 +456,12 @@ mod tests {
         );
     }
 
-    /// Stress member 5's piece: columns 68–74 of a rock whose visible columns are 68–93, the
-    /// raised pixels beside it reaching 19 columns further. The bearing keeps the piece's
-    /// centroid and takes in the rock's centre; a piece with nothing beyond keeps its bearing.
     /// The left eye alone, without a range: the bearing interval runs from the eye's direction
     /// to a right angle beyond, its middle 45° from where the rock was seen; the ray gives the
     /// rock's bearing from the centre at whatever range it turns out to be.
     #[test]
     fn an_unranged_left_detection_is_seen_along_its_ray() {
-        let calib = Calibration::parse(
-            "[image]\nwidth = 2048\nheight = 384\n[azimuth]\ncolumn0_deg = 102.0\n\
-             direction = \"clockwise\"\n[elevation]\nhorizon_row = 150.0\nfocal_px = 326.0\n\
-             [mast]\nheight_m = 1.5\n[stereo]\nbaseline_m = 0.3\n",
-            "test",
-        )
-        .expect("valid");
+        let calib = half_resolution_stereo();
         let model = SensorModel::default();
         let mut piece = blob([68, 222, 74, 228], Separation::Whole);
         piece.centroid[0] = 71.0;
@@ -489,15 +480,23 @@ mod tests {
         );
     }
 
-    #[test]
-    fn a_piece_with_raised_pixels_beyond_it_is_widened_to_the_rock() {
-        let calib = Calibration::parse(
+    /// A half-resolution panorama of a stereo head with a 0.3 m baseline.
+    fn half_resolution_stereo() -> Calibration {
+        Calibration::parse(
             "[image]\nwidth = 2048\nheight = 384\n[azimuth]\ncolumn0_deg = 102.0\n\
              direction = \"clockwise\"\n[elevation]\nhorizon_row = 150.0\nfocal_px = 326.0\n\
              [mast]\nheight_m = 1.5\n[stereo]\nbaseline_m = 0.3\n",
             "test",
         )
-        .expect("valid");
+        .expect("valid")
+    }
+
+    /// Stress member 5's piece: columns 68–74 of a rock whose visible columns are 68–93, the
+    /// raised pixels beside it reaching 19 columns further. The bearing keeps the piece's
+    /// centroid and takes in the rock's centre; a piece with nothing beyond keeps its bearing.
+    #[test]
+    fn a_piece_with_raised_pixels_beyond_it_is_widened_to_the_rock() {
+        let calib = half_resolution_stereo();
         let model = SensorModel::default();
         let range = RangeInterval::new(4.0, 5.0);
         let mut piece = blob([68, 222, 74, 228], Separation::Whole);
