@@ -8,6 +8,7 @@
 //! in range that two rocks fit, is separated into a nearer and a farther layer.
 
 use super::components::{bounds, connected, Component, PixelIndex};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
@@ -285,32 +286,36 @@ fn pixel_shifts(
     let stride = rw + 1;
     // Integral images wrap around u32: a window's sum (at most 765 per pixel) fits, so the
     // wrapped differences of four corners give it exactly, at half the memory traffic of i64.
-    let mut integral = vec![0u32; (rh + 1) * stride];
-    for s in 0..shifts {
-        let start = if partner.direction > 0 {
-            s
-        } else {
-            max_shift - s
-        };
-        for y in 0..rh {
-            let a = &own[y * rw..(y + 1) * rw];
-            let b = &other[y * ow + start..y * ow + start + rw];
-            let (above, below) = integral.split_at_mut((y + 1) * stride);
-            let above = &above[y * stride + 1..];
-            let mut run = 0u32;
-            for (((p, q), up), out) in a.iter().zip(b).zip(above).zip(&mut below[1..stride]) {
-                run = run.wrapping_add(p.abs_diff(*q));
-                *out = up.wrapping_add(run);
+    // Shifts in parallel, each thread with an integral image of its own: a large rock near
+    // the rover is most of a panorama's matching.
+    by_shift.par_chunks_mut(n).enumerate().for_each_init(
+        || vec![0u32; (rh + 1) * stride],
+        |integral, (s, costs)| {
+            let start = if partner.direction > 0 {
+                s
+            } else {
+                max_shift - s
+            };
+            for y in 0..rh {
+                let a = &own[y * rw..(y + 1) * rw];
+                let b = &other[y * ow + start..y * ow + start + rw];
+                let (above, below) = integral.split_at_mut((y + 1) * stride);
+                let above = &above[y * stride + 1..];
+                let mut run = 0u32;
+                for (((p, q), up), out) in a.iter().zip(b).zip(above).zip(&mut below[1..stride]) {
+                    run = run.wrapping_add(p.abs_diff(*q));
+                    *out = up.wrapping_add(run);
+                }
             }
-        }
-        for (&(xa, xb, ya, yb, scale), cost) in windows.iter().zip(&mut by_shift[s * n..]) {
-            let sum = integral[yb * stride + xb]
-                .wrapping_sub(integral[ya * stride + xb])
-                .wrapping_sub(integral[yb * stride + xa])
-                .wrapping_add(integral[ya * stride + xa]);
-            *cost = sum as f32 * scale;
-        }
-    }
+            for (&(xa, xb, ya, yb, scale), cost) in windows.iter().zip(costs) {
+                let sum = integral[yb * stride + xb]
+                    .wrapping_sub(integral[ya * stride + xb])
+                    .wrapping_sub(integral[yb * stride + xa])
+                    .wrapping_add(integral[ya * stride + xa]);
+                *cost = sum as f32 * scale;
+            }
+        },
+    );
     // Transposed in blocks that stay in cache.
     const BLOCK: usize = 32;
     let mut costs = vec![0f32; n * shifts];
