@@ -130,17 +130,14 @@ pub fn by_intervals(
     let mut pending: [RelationSet; 3] = std::array::from_fn(|k| candidates[k].difference(known[k]));
     // Each box carries the regions its ancestors could not rule out: an enclosure over a
     // sub-box lies within the enclosure over the box, so what a box excludes stays excluded
-    // below it, and only the relations with a region left need their enclosures.
-    // A box is carried with its ratios (the exponentials of its log-ratio bounds).
+    // below it, and only the relations with a region left need their enclosures. A box also
+    // carries its ratios (the exponentials of its log-ratio bounds).
     let ratios = start.map(|r| Interval::new(r.lo.exp(), r.hi.exp()));
     let mut stack = vec![(start, ratios, 0u32, pending)];
-    let mut boxes = 0u64;
-    let pending0 = pending;
     while let Some((log_ratios, ratios, depth, inherited)) = stack.pop() {
         if pending.iter().all(|p| p.is_empty()) {
             break;
         }
-        boxes += 1;
         let open: [RelationSet; 3] = std::array::from_fn(|k| inherited[k].intersection(pending[k]));
         if open.iter().all(|p| p.is_empty()) {
             continue;
@@ -193,20 +190,6 @@ pub fn by_intervals(
                 stack.push((next, next_ratios, depth + 1, alive));
             }
         }
-    }
-    if std::env::var_os("QRM_DBG").is_some() {
-        let added: u32 = (0..3)
-            .map(|k| kept[k].difference(known[k]).len() as u32)
-            .sum();
-        let p0: u32 = pending0.iter().map(|p| p.len() as u32).sum();
-        let unc: Vec<f64> = bearings
-            .iter()
-            .map(|b| b.uncertainty.to_degrees())
-            .collect();
-        eprintln!(
-            "BOX {boxes} pend {p0} added {added} unc {:.2} {:.2} {:.2}",
-            unc[0], unc[1], unc[2]
-        );
     }
     kept
 }
