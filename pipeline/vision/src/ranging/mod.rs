@@ -87,10 +87,27 @@ pub struct Ray {
 }
 
 impl Ray {
+    /// The ray from the station centre at `azimuth` (radians).
+    fn from_centre(azimuth: f64) -> Ray {
+        Ray {
+            azimuth: azimuth.rem_euclid(TAU),
+            half_baseline: 0.0,
+        }
+    }
+
     /// Bearing from the station centre of the ray's point `range` metres from the centre.
     pub fn direction_at(&self, range: f64) -> f64 {
-        let offset = (self.half_baseline / range.max(self.half_baseline)).asin();
-        (self.azimuth + if offset.is_finite() { offset } else { 0.0 }).rem_euclid(TAU)
+        (self.azimuth + self.offset_at(range)).rem_euclid(TAU)
+    }
+
+    /// How much further round than `azimuth` the ray's point `range` metres from the centre
+    /// lies: `asin(b / 2d)` for the left eye, 0 from the centre.
+    fn offset_at(&self, range: f64) -> f64 {
+        if self.half_baseline > 0.0 {
+            (self.half_baseline / range.max(self.half_baseline)).asin()
+        } else {
+            0.0
+        }
     }
 }
 
@@ -328,34 +345,25 @@ fn bearing_of(
     );
     let shift = 0.5 * (low + high) * calib.column_sign() * calib.column_width();
     let error = 0.5 * (high - low) * calib.column_width();
-    let (angle, spread, ray_offset) = match right {
+    let (angle, spread, ray) = match right {
         Some(r) => {
             let difference = azimuth_difference(calib.azimuth(r.centroid[0]), left);
-            (left + 0.5 * difference, 0.0, 0.0)
+            let angle = left + 0.5 * difference;
+            (angle, 0.0, Ray::from_centre(angle + shift))
         }
         None if half_baseline > 0.0 => {
-            let offset = |range: f64| (half_baseline / range.max(half_baseline)).asin();
-            let (small, large) = (offset(range.high), offset(range.low.max(half_baseline)));
-            (
-                left + 0.5 * (small + large),
-                0.5 * (large - small),
+            let eye = Ray {
+                azimuth: (left + shift).rem_euclid(TAU),
                 half_baseline,
-            )
+            };
+            let (small, large) = (eye.offset_at(range.high), eye.offset_at(range.low));
+            (left + 0.5 * (small + large), 0.5 * (large - small), eye)
         }
-        None => (left, 0.0, 0.0),
+        None => (left, 0.0, Ray::from_centre(left + shift)),
     };
     let bearing = Bearing {
         angle: (angle + shift).rem_euclid(TAU),
         uncertainty: error + spread,
-    };
-    let ray = Ray {
-        azimuth: if ray_offset > 0.0 {
-            left + shift
-        } else {
-            angle + shift
-        }
-        .rem_euclid(TAU),
-        half_baseline: ray_offset,
     };
     (bearing, ray)
 }
