@@ -148,7 +148,7 @@ impl<C: Calculus> KnownMap<C> {
                 match decision {
                     Decision::Matched(landmark) => identified.push((i, landmark)),
                     Decision::HeldBack(candidates) => ambiguous.push((i, candidates)),
-                    Decision::New => {}
+                    Decision::New | Decision::Withheld => {}
                 }
             }
         }

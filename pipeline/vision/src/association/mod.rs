@@ -142,6 +142,9 @@ pub struct Evidence {
     pub placed: Option<Placed>,
     /// The ray it was seen along.
     pub ray: Ray,
+    /// A piece touching another detection ([`crate::ranging::Ranged::piece`]): it may be
+    /// part of a rock or hold parts of two, so it observes landmarks but founds none.
+    pub piece: bool,
 }
 
 /// One station as association sees it: the bearings and range order of its usable detections,
@@ -164,6 +167,17 @@ pub enum Decision {
     Matched(LandmarkId),
     New,
     HeldBack(Vec<LandmarkId>),
+    /// A piece ([`Evidence::piece`]) that matched no landmark: not made a landmark of its own.
+    Withheld,
+}
+
+/// A new landmark for the detection with `evidence`, unless it is a piece.
+fn founded(evidence: &Evidence) -> Decision {
+    if evidence.piece {
+        Decision::Withheld
+    } else {
+        Decision::New
+    }
 }
 
 /// Associates the detections of one station with the landmarks of `map` and `gallery`;
@@ -181,7 +195,7 @@ pub fn associate<C: Calculus>(
     let placed: Vec<Option<Placed>> = evidence.iter().map(|e| e.placed).collect();
     let n = evidence.len();
     if gallery.is_empty() {
-        return vec![Decision::New; n];
+        return evidence.iter().map(founded).collect();
     }
     let candidates: Vec<Vec<(LandmarkId, f64)>> = evidence
         .iter()
@@ -241,7 +255,7 @@ pub fn associate<C: Calculus>(
                     .map(|p| unaccounted_near(p, &registrations, &anchored))
                     .unwrap_or_default();
                 if unaccounted.is_empty() {
-                    Decision::New
+                    founded(&evidence[i])
                 } else {
                     Decision::HeldBack(unaccounted)
                 }
@@ -721,6 +735,7 @@ mod tests {
                 width: None,
                 placed: Some(at(p)),
                 ray: toward(p),
+                piece: false,
             })
             .collect();
         (
@@ -762,6 +777,19 @@ mod tests {
             &AssociationSettings::default(),
             lately,
         )
+    }
+
+    /// The first station founds a landmark for each detection but the piece touching another,
+    /// which may be part of a rock or hold parts of two.
+    #[test]
+    fn a_piece_founds_no_landmark() {
+        let (_, mut station) = station(&[[5.0, 0.0], [0.0, 6.0], [-4.0, -3.0]]);
+        station.detections[1].piece = true;
+        let decisions = associate_station(&(Gallery::default(), station), &[]);
+        assert_eq!(
+            decisions,
+            [Decision::New, Decision::Withheld, Decision::New]
+        );
     }
 
     fn frame(points: &[[f64; 2]]) -> Frame {

@@ -128,6 +128,10 @@ pub struct Ranged {
     pub fused: RangeInterval,
     /// The cues did not overlap: `fused` is their hull and no cue is trusted over another.
     pub conflict: bool,
+    /// It touches another detection ([`neighbour_reach`]): a piece of a rock, or a rock with a
+    /// piece of another. Its bearing interval and ground cue reach over the neighbour's
+    /// columns, and its apparent width says nothing of its rock's.
+    pub piece: bool,
 }
 
 /// Bearings and the flat-ground and stereo cues of `primary` (with `right` for stereo
@@ -153,14 +157,35 @@ pub fn observe(
         .map(|(i, d)| {
             let columns = apparent_columns(d);
             let angular_width = columns * calib.column_width();
-            let ground = ground_cue(d, i, primary, calib, model, angular_width, half_baseline);
+            // A piece touching another may reach under it: its rock's centre and reach are
+            // judged over the columns the two cover.
+            let reach = neighbour_reach(i, primary, calib.image.width);
+            let piece = reach != [0, 0];
+            let spread = Detection {
+                beyond_columns: [
+                    d.beyond_columns[0].max(reach[0]),
+                    d.beyond_columns[1].max(reach[1]),
+                ],
+                ..d.clone()
+            };
+            let widest = columns + f64::from(spread.beyond_columns[0] + spread.beyond_columns[1]);
+            let reach_width = if piece {
+                widest * calib.column_width()
+            } else {
+                angular_width
+            };
+            let ground = ground_cue(d, i, primary, calib, model, reach_width, half_baseline);
             let right_detection = matches[i].zip(right).map(|(j, r)| &r[j]);
             let stereo = right_detection.map(|r| stereo_cue(d, r, calib, model));
             let (fused, conflict) = fuse([ground, stereo, None]);
-            let (bearing, ray) = bearing_of(d, right_detection, calib, model, half_baseline, fused);
+            let (bearing, _) =
+                bearing_of(&spread, right_detection, calib, model, half_baseline, fused);
+            // The ray is where the piece itself was seen.
+            let (_, ray) = bearing_of(d, right_detection, calib, model, half_baseline, fused);
             Ranged {
                 bearing,
                 ray,
+                piece,
                 stereo_column: right_detection.map(|r| r.centroid[0]),
                 angular_width,
                 ground,
@@ -266,15 +291,47 @@ fn ground_cue(
 /// of a blob separated by parallax is not doubted for touching a farther part of the same
 /// blob: the edge between them is its own outline.
 pub fn touches_neighbour(index: usize, all: &[Detection], width: u32) -> bool {
+    neighbours(index, all, width).next().is_some()
+}
+
+/// The detections [`touches_neighbour`] finds touching detection `index`.
+fn neighbours<'a>(
+    index: usize,
+    all: &'a [Detection],
+    width: u32,
+) -> impl Iterator<Item = &'a Detection> + 'a {
     let me = &all[index];
-    all.iter().enumerate().any(|(j, other)| {
-        j != index
+    all.iter().enumerate().filter_map(move |(j, other)| {
+        (j != index
             && !(me.separation == Separation::Nearer
                 && other.separation == Separation::Farther
                 && other.blob == me.blob)
             && columns_overlap(me.bbox, other.bbox, 2, width)
             && other.bbox[1] <= me.bbox[3]
-            && me.bbox[1] <= other.bbox[3]
+            && me.bbox[1] <= other.bbox[3])
+            .then_some(other)
+    })
+}
+
+/// Columns before and after detection `index`'s box that the detections touching it cover:
+/// if it is a piece of a rock, the rest may lie there (one rock in two pieces, or its side
+/// hidden by a nearer rock). `[0, 0]` for a detection touching none.
+fn neighbour_reach(index: usize, all: &[Detection], width: u32) -> [u32; 2] {
+    let me = &all[index];
+    let (first, last) = (i64::from(me.bbox[0]), i64::from(me.bbox[2]));
+    let width = i64::from(width);
+    neighbours(index, all, width as u32).fold([0, 0], |[before, after], other| {
+        // The neighbour's span in the unwrapping nearest to this box (either may wrap).
+        let (start, end) = [0, width, -width]
+            .into_iter()
+            .map(|s| (i64::from(other.bbox[0]) + s, i64::from(other.bbox[2]) + s))
+            .max_by_key(|&(start, end)| last.min(end) - first.max(start))
+            .unwrap_or_default();
+        let columns = |c: i64| u32::try_from(c.max(0)).unwrap_or(u32::MAX);
+        [
+            before.max(columns(first - start)),
+            after.max(columns(end - last)),
+        ]
     })
 }
 
@@ -542,6 +599,60 @@ mod tests {
             fuse([None, None, None]),
             (RangeInterval::unbounded(), false)
         );
+    }
+
+    /// Two pieces side by side, across the seam of a 2048-column panorama: each one's reach
+    /// is the columns the other covers beyond it, whichever unwrapping holds the boxes.
+    #[test]
+    fn a_piece_reaches_over_the_columns_its_neighbour_covers() {
+        let pieces = [
+            blob([2040, 200, 2050, 220], Separation::Whole),
+            blob([3, 205, 12, 224], Separation::Whole),
+            blob([600, 200, 620, 220], Separation::Whole),
+        ];
+        assert_eq!(neighbour_reach(0, &pieces, 2048), [0, 10]);
+        assert_eq!(neighbour_reach(1, &pieces, 2048), [11, 0]);
+        assert_eq!(neighbour_reach(2, &pieces, 2048), [0, 0]);
+    }
+
+    /// A rock in two pieces (columns 100–139, cut at column 120): each piece's bearing interval
+    /// takes in the whole rock's centre, each one's ray stays where the piece was seen, and
+    /// only the pieces are flagged. Brute force: every centre of a rock holding the piece and
+    /// within its neighbour's columns lies in the interval.
+    #[test]
+    fn a_piece_touching_another_takes_in_the_rock_it_may_be_part_of() {
+        let calib = half_resolution_stereo();
+        let model = SensorModel::default();
+        let primary = [
+            blob([100, 200, 119, 230], Separation::Whole),
+            blob([120, 200, 139, 230], Separation::Whole),
+            blob([400, 200, 419, 230], Separation::Whole),
+        ];
+        let ranged = observe(&primary, None, PrimaryEye::Mono, &calib, &model);
+        assert_eq!(
+            ranged.iter().map(|r| r.piece).collect::<Vec<_>>(),
+            [true, true, false]
+        );
+        let holds = |b: Bearing, column: f64| {
+            azimuth_difference(calib.azimuth(column), b.angle).abs() <= b.uncertainty
+        };
+        for (k, own) in [(0, (100.0, 120.0)), (1, (120.0, 140.0))] {
+            let r = ranged[k];
+            assert!(
+                azimuth_difference(r.ray.azimuth, calib.azimuth(primary[k].centroid[0])).abs()
+                    < 1e-12
+            );
+            // The rock spans the piece's columns and any run of the neighbour's beside it.
+            for first in 100..=own.0 as u32 {
+                for end in own.1 as u32..=140 {
+                    let centre = 0.5 * f64::from(first + end);
+                    assert!(holds(r.bearing, centre), "piece {k}, rock {first}..{end}");
+                }
+            }
+        }
+        // The lone detection keeps the centroid's own error.
+        let lone = ranged[2].bearing;
+        assert!(holds(lone, 410.0) && !holds(lone, 416.0), "{lone:?}");
     }
 
     #[test]

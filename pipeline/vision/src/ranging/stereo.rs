@@ -42,6 +42,12 @@ pub fn match_stereo(
             if left[i].separation != Separation::Whole {
                 return None;
             }
+            // Nor has a piece touching another: its partner may be the whole rock, whose
+            // centroid lies elsewhere (marsyard seed 7, station 26: a piece of a rock filling
+            // a third of the view took the whole rock's centroid, 0.2 m too near).
+            if super::touches_neighbour(i, left, width) {
+                return None;
+            }
             // The best partner, if it is a doubtful detection, gives no cue: falling back to
             // the runner-up would pair the rock with a neighbour.
             let (j, _) = best_right(i)?;

@@ -3,7 +3,7 @@
 //! observations are retried after every station.
 
 use super::record::{
-    Association, DetectionRecord, MetricsRecord, RangeRecord, SplitRecord, StationRecord,
+    Association, DetectionRecord, Exclusion, MetricsRecord, RangeRecord, SplitRecord, StationRecord,
 };
 use super::selection;
 use crate::association::audit::{regroup, Regrouping};
@@ -224,6 +224,13 @@ impl<C: Calculus> Mapper<C> {
         record.seconds.associate = start.elapsed().as_secs_f64();
 
         let start = Instant::now();
+        for (position, decision) in decisions.iter().enumerate() {
+            if *decision == Decision::Withheld {
+                record.detections[usable[position]].association = Association::Unused {
+                    reason: Some(Exclusion::Touching),
+                };
+            }
+        }
         let associated =
             Associated::new(usable, evidence.detections, decisions, self.next_landmark);
         self.apply_size_cue(station, &mut ranged, &associated);
@@ -272,7 +279,7 @@ impl<C: Calculus> Mapper<C> {
     }
 
     /// The size cue, for landmarks whose width earlier stations bounded (not for parts of a
-    /// blob separated by parallax: see `selection::width_of`; nor for luminance-mode
+    /// blob separated by parallax or pieces: see `selection::width_of`; nor for luminance-mode
     /// detections: the stereo test's window widens every blob by a few columns, far more of
     /// a distant rock's width than of a near one's, beyond the cue's margin).
     fn apply_size_cue(
@@ -284,7 +291,7 @@ impl<C: Calculus> Mapper<C> {
         for s in &associated.fused {
             let i = associated.usable[s.position];
             let d = &station.primary[i];
-            if d.separation != Separation::Whole || d.contact_slack_rows > 0.0 {
+            if d.separation != Separation::Whole || d.contact_slack_rows > 0.0 || ranged[i].piece {
                 continue;
             }
             if let Some(width) = self.gallery.profile(s.landmark).and_then(|p| p.width) {
@@ -580,7 +587,13 @@ impl<C: Calculus> Mapper<C> {
                     pending[k].candidates = candidates;
                     continue;
                 }
-                // Every candidate rejected: a rock the map did not have.
+                // Every candidate rejected: a rock the map did not have, unless a piece,
+                // which founds no landmark (`association::Decision::Withheld`).
+                Some(_) if item.evidence.piece => {
+                    done[k] = true;
+                    self.expired += 1;
+                    continue;
+                }
                 Some(_) => done[k] = true,
             }
             let landmark = self.next_landmark;
@@ -746,6 +759,7 @@ impl Associated {
                     next_landmark += 1;
                 }
                 Decision::HeldBack(candidates) => held.push((position, candidates.clone())),
+                Decision::Withheld => {}
             }
         }
         Associated {

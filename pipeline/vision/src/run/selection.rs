@@ -26,8 +26,10 @@ pub(crate) fn usable(station: &StationDetections, ranged: &[Ranged], width: u32)
 }
 
 /// Why mapping leaves detection `i` out, if it does: detections the detector doubts (possibly
-/// several rocks, or part of one), slivers, stacks, pieces touching another piece, and those
-/// whose bearing is too uncertain to measure with.
+/// several rocks, or part of one), slivers, stacks, pieces touching another in luminance mode,
+/// and those whose bearing is too uncertain to measure with. In colour mode pieces touching
+/// another are used, with their bearings and ranges widened over the neighbour
+/// ([`Ranged::piece`]), but found no landmark.
 pub(super) fn exclusion(
     station: &StationDetections,
     ranged: &[Ranged],
@@ -43,7 +45,11 @@ pub(super) fn exclusion(
         Some(Exclusion::Sliver)
     } else if stacked(d) {
         Some(Exclusion::Stacked)
-    } else if ranging::touches_neighbour(i, &station.primary, width) {
+    } else if station.channels == Channels::Luminance
+        && ranging::touches_neighbour(i, &station.primary, width)
+    {
+        // By luminance, a blob's sides are where the stereo test's window says the ground
+        // ends, columns off the rock's: a piece's reach over its neighbour is not its rock's.
         Some(Exclusion::Touching)
     } else if ranged[i].bearing.uncertainty >= MAX_BEARING_UNCERTAINTY {
         Some(Exclusion::WideBearing)
@@ -75,6 +81,7 @@ pub(crate) fn station_evidence(
                 width: width_of(&station.primary[i], &ranged[i], model),
                 placed: placed(&ranged[i]),
                 ray: ranged[i].ray,
+                piece: ranged[i].piece,
             })
             .collect(),
         colour: station.channels == Channels::Colour,
@@ -86,11 +93,11 @@ pub(crate) fn station_evidence(
 }
 
 /// The physical width a detection implies for its rock (`ranging::width_evidence`), unless it
-/// is a part of a blob separated by parallax: a false cut of one large rock (its sides read
-/// farther than its middle) leaves a part narrower than the rock, which would bound the
-/// landmark's width too low and put the size cue's ranges too far.
+/// is a part of a blob separated by parallax or a piece touching another: a false cut of one
+/// large rock (its sides read farther than its middle) leaves a part narrower than the rock,
+/// which would bound the landmark's width too low and put the size cue's ranges too far.
 fn width_of(d: &Detection, ranged: &Ranged, model: &SensorModel) -> Option<RangeInterval> {
-    (d.separation == Separation::Whole)
+    (d.separation == Separation::Whole && !ranged.piece)
         .then(|| ranging::width_evidence(ranged, model))
         .flatten()
 }
@@ -167,6 +174,7 @@ mod tests {
             size: None,
             fused: RangeInterval::new(4.0, 5.0),
             conflict: false,
+            piece: false,
         }
     }
 
@@ -206,11 +214,11 @@ mod tests {
                 Some(Exclusion::Doubted),
                 Some(Exclusion::Sliver),
                 Some(Exclusion::Stacked),
-                Some(Exclusion::Touching),
-                Some(Exclusion::Touching),
+                None,
+                None,
                 Some(Exclusion::WideBearing),
             ]
         );
-        assert_eq!(usable(&station, &all, 4096), [0]);
+        assert_eq!(usable(&station, &all, 4096), [0, 5, 6]);
     }
 }
