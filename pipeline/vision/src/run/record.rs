@@ -114,8 +114,8 @@ pub enum Exclusion {
     Sliver,
     /// Taller than wide: a farther rock seen over a nearer one.
     Stacked,
-    /// Its box meets another detection's (two rocks, or one rock in two pieces), and it
-    /// matched no landmark: a piece founds none.
+    /// Its box meets another detection's (two rocks, or one rock in two pieces): left out in
+    /// luminance mode; in colour mode, used but matched to no landmark (a piece founds none).
     Touching,
     /// Its bearing interval is too wide to measure with.
     WideBearing,

@@ -178,7 +178,8 @@ mod tests {
         }
     }
 
-    /// Each detection left out says why, and only those left out are not usable.
+    /// Each detection left out says why, and only those left out are not usable; pieces
+    /// touching each other are used in colour mode only.
     #[test]
     fn every_left_out_detection_has_its_reason() {
         let primary = vec![
@@ -220,5 +221,15 @@ mod tests {
             ]
         );
         assert_eq!(usable(&station, &all, 4096), [0, 5, 6]);
+        // By luminance, the pieces touching each other are left out.
+        let station = StationDetections {
+            channels: Channels::Luminance,
+            ..station
+        };
+        let reasons: Vec<Option<Exclusion>> = (5..=6)
+            .map(|i| exclusion(&station, &all, i, 4096))
+            .collect();
+        assert_eq!(reasons, [Some(Exclusion::Touching); 2]);
+        assert_eq!(usable(&station, &all, 4096), [0]);
     }
 }
