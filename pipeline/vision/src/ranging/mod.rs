@@ -128,9 +128,10 @@ pub struct Ranged {
     pub fused: RangeInterval,
     /// The cues did not overlap: `fused` is their hull and no cue is trusted over another.
     pub conflict: bool,
-    /// It touches another detection ([`neighbour_reach`]): a piece of a rock, or a rock with a
-    /// piece of another. Its bearing interval and ground cue reach over the neighbour's
-    /// columns, and its apparent width says nothing of its rock's.
+    /// A detection touching it reaches beyond its columns ([`neighbour_reach`]): it may be a
+    /// piece of a rock, or a rock with a piece of another. Its bearing interval and ground cue
+    /// reach over the neighbour's columns, and its apparent width says nothing of its rock's.
+    /// (One whose touching neighbours all lie within its own columns is not a piece.)
     pub piece: bool,
 }
 
@@ -161,27 +162,27 @@ pub fn observe(
             // judged over the columns the two cover.
             let reach = neighbour_reach(i, primary, calib.image.width);
             let piece = reach != [0, 0];
-            let spread = Detection {
+            let spread = piece.then(|| Detection {
                 beyond_columns: [
                     d.beyond_columns[0].max(reach[0]),
                     d.beyond_columns[1].max(reach[1]),
                 ],
                 ..d.clone()
-            };
-            let widest = columns + f64::from(spread.beyond_columns[0] + spread.beyond_columns[1]);
-            let reach_width = if piece {
-                widest * calib.column_width()
-            } else {
-                angular_width
-            };
+            });
+            let reach_width = spread.as_ref().map_or(angular_width, |s| {
+                let beyond = f64::from(s.beyond_columns[0] + s.beyond_columns[1]);
+                (columns + beyond) * calib.column_width()
+            });
             let ground = ground_cue(d, i, primary, calib, model, reach_width, half_baseline);
             let right_detection = matches[i].zip(right).map(|(j, r)| &r[j]);
             let stereo = right_detection.map(|r| stereo_cue(d, r, calib, model));
             let (fused, conflict) = fuse([ground, stereo, None]);
-            let (bearing, _) =
-                bearing_of(&spread, right_detection, calib, model, half_baseline, fused);
-            // The ray is where the piece itself was seen.
-            let (_, ray) = bearing_of(d, right_detection, calib, model, half_baseline, fused);
+            // The ray is where the detection itself was seen; a piece's bearing takes in the
+            // columns it may reach over.
+            let (bearing, ray) = bearing_of(d, right_detection, calib, model, half_baseline, fused);
+            let bearing = spread.as_ref().map_or(bearing, |s| {
+                bearing_of(s, right_detection, calib, model, half_baseline, fused).0
+            });
             Ranged {
                 bearing,
                 ray,
