@@ -4,7 +4,7 @@
 //! a metre or two from the true one fits the loose placements of a far frame as well. Every
 //! earlier station that shares a matched landmark and at least [`FEWEST_OTHERS`] others with
 //! the current one is a second witness: the motion between the two stations, fitted on the
-//! *other* shared landmarks, must bring the landmark's two placements within their radii
+//! *other* shared landmarks, must bring the landmark's two placements within their ellipses
 //! (plus the registration's slack), the same tolerance a registration pair meets. A landmark
 //! placed beyond that at any such station is a different rock there, and its match is undone
 //! (marsyard seed 3 at half resolution: landmark 9 took rock 16, 1.3 m from its own, at
@@ -14,7 +14,8 @@
 //! with the landmark as its only candidate, so it is fused later only as a new landmark, once
 //! the map rejects the match.
 
-use super::registration::{Frame, Motion, Placed};
+use super::registration::{Frame, Motion};
+use super::Placed;
 use qrm_core::map::LandmarkId;
 
 /// Fewest other shared landmarks that fix the motion between two stations.
@@ -77,7 +78,7 @@ mod tests {
             departed: Vec::new(),
             landmarks: points
                 .iter()
-                .map(|&(l, point)| (l, Placed { point, radius: 0.3 }))
+                .map(|&(l, point)| (l, Placed::disc(point, 0.3)))
                 .collect(),
         }
     }
@@ -97,7 +98,7 @@ mod tests {
             .map(|(l, &[x, y])| {
                 let (x, y) = (x - 2.0, y);
                 let point = [cos * x + sin * y, -sin * x + cos * y];
-                (l as LandmarkId, Placed { point, radius: 0.3 })
+                (l as LandmarkId, Placed::disc(point, 0.3))
             })
             .collect();
         (frame(&earlier), current)

@@ -37,6 +37,7 @@
 pub mod agreement;
 pub mod audit;
 mod gallery;
+mod placement;
 mod recency;
 mod registration;
 mod significance;
@@ -45,8 +46,9 @@ pub mod sketch;
 pub(crate) mod test_drive;
 
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
+pub use placement::Placed;
 pub use recency::LastSeen;
-pub use registration::{displacement, register, Frame, Placed, Registration};
+pub use registration::{displacement, register, Frame, Registration};
 use registration::{MIN_INLIERS, SIGNIFICANT_NFA};
 pub use sketch::Sketch;
 
@@ -285,10 +287,10 @@ fn unaccounted_near(
     near
 }
 
-/// Whether the station's placement `p`, moved into a frame by `registration`, lies within
-/// `slack` metres beyond the two radii of the frame's landmark placed at `q`.
+/// Whether the station's placement `p`, moved into a frame by `registration`, may be the
+/// frame's landmark placed at `q`, both placements grown by `slack` metres between them.
 fn within(p: Placed, q: Placed, registration: &Registration, slack: f64) -> bool {
-    registration::distance(registration.to_frame(p.point), q.point) <= p.radius + q.radius + slack
+    placement::separation(&registration.to_frame_placed(&p), &q, slack).within()
 }
 
 /// Whether `frame`, registered by `registration`, places the detection at `p` where it may be
@@ -710,7 +712,7 @@ mod tests {
     }
 
     fn at(point: [f64; 2]) -> Placed {
-        Placed { point, radius: 0.3 }
+        Placed::disc(point, 0.3)
     }
 
     /// The station's detections at `points` (bearings from the positions, no range order),
@@ -851,7 +853,7 @@ mod tests {
                 .collect();
             let mut seen = station(&points);
             for detection in &mut seen.1.detections {
-                detection.placed = detection.placed.map(|p| Placed { radius: 0.6, ..p });
+                detection.placed = detection.placed.map(|p| Placed::disc(p.point, 0.6));
             }
             seen
         };

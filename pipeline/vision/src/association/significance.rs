@@ -10,7 +10,9 @@
 //! fields cluster: the mean density would understate chance there). Multiplied by the number of hypotheses tried, this is the
 //! expected number of chance fits as tight as the one seen, its *number of false alarms*
 //! (NFA). A fit whose NFA is far below one is no accident, whatever the sensor's error bounds:
-//! the test uses the residuals the fit achieved, not the worst case the placement radii allow.
+//! the test uses the residuals the fit achieved, not the worst case the placements allow. A
+//! residual is a [`super::placement::Separation`] distance: for elongated placements, the
+//! radius of a disc as large as the ellipse of the residual, so `π r²` stays its area.
 
 use std::f64::consts::PI;
 

@@ -15,7 +15,9 @@
 //! where the sketch last put them (`Frame::departed`) until the sketch starts again, to rule
 //! out look-alikes far from there.
 
-use super::registration::{misfit, Frame, Motion, Placed};
+use super::registration::{misfit, Frame, Motion};
+use super::Placed;
+use nalgebra::{Matrix2, Vector2};
 use qrm_core::map::LandmarkId;
 
 /// Stations a landmark stays in the sketch after it was last seen (a rover moves 1–2 m a
@@ -26,7 +28,7 @@ pub const WINDOW: usize = 25;
 /// views, through which the sketch drifts slowly with the drive, rather than its first ones.
 const DECAY: f64 = 0.7;
 
-/// Smallest radius of a sketched position, metres: rocks are not points, and a range
+/// Smallest semi-axis of a sketched position, metres: rocks are not points, and a range
 /// interval's middle is not the rock's centre.
 const MIN_RADIUS_M: f64 = 0.25;
 
@@ -38,8 +40,9 @@ const MIN_SHARED: usize = 3;
 struct Sketched {
     landmark: LandmarkId,
     placed: Placed,
-    /// Inverse-variance weight of the estimate, `1 / radius²` summed over decayed sightings.
-    weight: f64,
+    /// Information of the estimate: the inverse of each sighting's ellipse (`1 / radius²`
+    /// for a disc), summed over decayed sightings.
+    weight: Matrix2<f64>,
     /// The last station that saw it.
     seen: usize,
 }
@@ -101,10 +104,7 @@ impl Sketch {
             None => return false,
         };
         for &(landmark, p) in sightings {
-            let placed = Placed {
-                point: motion.apply(p.point),
-                radius: p.radius.max(MIN_RADIUS_M),
-            };
+            let placed = motion.apply_placed(&p).at_least(MIN_RADIUS_M);
             self.merge(landmark, placed, station);
         }
         let (kept, departed): (Vec<Sketched>, Vec<Sketched>) = std::mem::take(&mut self.landmarks)
@@ -131,25 +131,31 @@ impl Sketch {
         Motion::consensus(pairs, MIN_SHARED)
     }
 
-    /// Averages a new placement into a landmark's estimate (inverse-variance, the old
-    /// weight decayed), or adds the landmark. A placement away from the estimate (an outlier
-    /// of the station's motion) is left out: if the estimate is the wrong one, the landmark
-    /// leaves the sketch after [`WINDOW`] stations and comes back afresh.
+    /// Averages a new placement into a landmark's estimate (inverse-variance: each ellipse's
+    /// inverse weighs it, the old weight decayed), or adds the landmark. Ellipses along
+    /// different bearings cross, so a rock seen from two directions is placed tightly both
+    /// ways. A placement away from the estimate (an outlier of the station's motion) is left
+    /// out: if the estimate is the wrong one, the landmark leaves the sketch after [`WINDOW`]
+    /// stations and comes back afresh.
     fn merge(&mut self, landmark: LandmarkId, placed: Placed, station: usize) {
-        let weight = placed.radius.powi(-2);
+        let Some(weight) = placed.shape.try_inverse() else {
+            return;
+        };
         match self.landmarks.iter_mut().find(|s| s.landmark == landmark) {
             Some(s) if misfit(&Motion::identity(), placed, s.placed) > 0.0 => {}
             Some(s) => {
-                let old = DECAY * s.weight;
+                let old = s.weight * DECAY;
                 let total = old + weight;
-                let mix = |a: f64, b: f64| (a * old + b * weight) / total;
-                s.placed = Placed {
-                    point: [
-                        mix(s.placed.point[0], placed.point[0]),
-                        mix(s.placed.point[1], placed.point[1]),
-                    ],
-                    radius: total.sqrt().recip().max(MIN_RADIUS_M),
+                let Some(shape) = total.try_inverse() else {
+                    return;
                 };
+                let mixed = shape
+                    * (old * Vector2::from(s.placed.point) + weight * Vector2::from(placed.point));
+                s.placed = Placed {
+                    point: [mixed[0], mixed[1]],
+                    shape,
+                }
+                .at_least(MIN_RADIUS_M);
                 s.weight = total;
                 s.seen = station;
             }
@@ -170,7 +176,7 @@ mod tests {
     use crate::association::registration::tests::FIELD;
 
     fn placed(point: [f64; 2]) -> Placed {
-        Placed { point, radius: 0.3 }
+        Placed::disc(point, 0.3)
     }
 
     /// FIELD's rocks as station `k` of a drive sees them: turned by `angle` and shifted.
@@ -234,8 +240,35 @@ mod tests {
         let p = position(&sketch, 1, 0).expect("in the sketch");
         // Between the two placements (the fit spreads the nudge over the four pairs).
         assert!(p[0] > FIELD[0][0] && p[0] < FIELD[0][0] + 0.2, "{p:?}");
-        let radius = sketch.frame(1).landmarks[0].1.radius;
+        let radius = sketch.frame(1).landmarks[0].1.reach();
         assert!((MIN_RADIUS_M..0.3).contains(&radius), "{radius}");
+    }
+
+    /// A rock placed by two stations along crossing bearings, each 2 m deep and 5 cm wide, is
+    /// placed within a few decimetres both ways, not 2 m along either: where the ellipses cross.
+    #[test]
+    fn placements_along_crossing_bearings_place_a_rock_tightly() {
+        let rock = [4.0, 3.0];
+        let along = |from: [f64; 2], error: f64| {
+            let angle = (rock[1] - from[1]).atan2(rock[0] - from[0]);
+            let point = [rock[0] + error * angle.cos(), rock[1] + error * angle.sin()];
+            Placed::along(point, angle, 2.0, 0.05)
+        };
+        // Three other rocks, tightly placed, fix the second station's motion into the sketch.
+        let others = |p: [f64; 2]| Placed::disc(p, 0.05);
+        let fixed = [[-3.0, 2.0], [1.0, -5.0], [-4.0, -4.0]];
+        let sightings = |from: [f64; 2], error: f64| -> Vec<(LandmarkId, Placed)> {
+            std::iter::once((0, along(from, error)))
+                .chain((1..).zip(fixed.map(others)))
+                .collect()
+        };
+        let mut sketch = Sketch::default();
+        // Both placements 1.5 m off along their bearings, from the origin and from (8, 0).
+        sketch.update(0, &sightings([0.0, 0.0], 1.5));
+        sketch.update(1, &sightings([8.0, 0.0], -1.5));
+        let placed = sketch.frame(2).landmarks[0].1;
+        assert!(distance(placed.point, rock) < 0.2, "{placed:?}");
+        assert!(placed.reach() < 0.4, "{placed:?}");
     }
 
     #[test]

@@ -72,10 +72,7 @@ pub fn seen(step: usize, wrong: usize) -> Seen {
     .expect("a valid view");
     let placed = rocks
         .iter()
-        .map(|&r| Placed {
-            point: [rock(r).x - station.x, rock(r).y - station.y],
-            radius: 0.3,
-        })
+        .map(|&r| Placed::disc([rock(r).x - station.x, rock(r).y - station.y], 0.3))
         .collect();
     Seen {
         rocks,

@@ -109,13 +109,18 @@ fn placed(r: &Ranged) -> Option<Placed> {
 }
 
 /// The rough position of a rock at `bearing` (± `uncertainty`) and range in `[low, high]`
-/// metres: the middle of the interval along the bearing, with a radius covering the interval
-/// and the bearing error; none when the range is unbounded or wider than its middle.
+/// metres: the middle of the interval along the bearing, in an ellipse reaching over the
+/// interval along the bearing and over the bearing error at the far end across it; none when
+/// the range is unbounded or wider than its middle.
 pub(crate) fn placement(bearing: f64, uncertainty: f64, [low, high]: [f64; 2]) -> Option<Placed> {
     let middle = 0.5 * (low + high);
-    (high.is_finite() && high - low < middle).then(|| Placed {
-        point: [middle * bearing.cos(), middle * bearing.sin()],
-        radius: 0.5 * (high - low) + high * uncertainty,
+    (high.is_finite() && high - low < middle).then(|| {
+        Placed::along(
+            [middle * bearing.cos(), middle * bearing.sin()],
+            bearing,
+            0.5 * (high - low),
+            high * uncertainty,
+        )
     })
 }
 
