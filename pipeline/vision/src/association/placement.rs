@@ -157,13 +157,20 @@ fn eigenvalues(shape: &Matrix2<f64>) -> [f64; 2] {
     [mean - spread, mean + spread]
 }
 
-/// The ellipse with each semi-axis `a` replaced by `change(a)`, in the same directions.
+/// The ellipse with each semi-axis `a` replaced by `change(a)`, in the same directions: by the
+/// projectors onto the two eigenvectors, `(shape − λ₋ I) / (λ₊ − λ₋)` and its complement (in
+/// closed form: registration grows every placement it compares, and a general eigensolver
+/// took a tenth of a run's time).
 fn with_semi_axes(shape: &Matrix2<f64>, change: impl Fn(f64) -> f64) -> Matrix2<f64> {
-    let eigen = shape.symmetric_eigen();
-    let axes = eigen
-        .eigenvalues
-        .map(|value| change(value.max(0.0).sqrt()).powi(2));
-    eigen.eigenvectors * Matrix2::from_diagonal(&axes) * eigen.eigenvectors.transpose()
+    let [low, high] = eigenvalues(shape);
+    let changed = |value: f64| change(value.max(0.0).sqrt()).powi(2);
+    let spread = high - low;
+    if spread <= 1e-12 * high.abs().max(f64::MIN_POSITIVE) {
+        return Matrix2::identity() * changed(0.5 * (low + high));
+    }
+    let major = (shape - Matrix2::identity() * low) / spread;
+    let minor = Matrix2::identity() - major;
+    major * changed(high) + minor * changed(low)
 }
 
 #[cfg(test)]
@@ -203,6 +210,21 @@ mod tests {
     }
 
     proptest! {
+        /// The closed-form growth of an ellipse agrees with growing its eigen-decomposition's
+        /// semi-axes.
+        #[test]
+        fn growing_an_ellipse_grows_its_semi_axes(
+            along in 0.0f64..3.0, across in 0.0f64..3.0, angle in 0.0f64..6.3, grown in 0.0f64..1.0,
+        ) {
+            let shape = Placed::along([0.0, 0.0], angle, along, across).shape;
+            let eigen = shape.symmetric_eigen();
+            let axes = eigen.eigenvalues.map(|v| (v.max(0.0).sqrt() + grown).powi(2));
+            let expected =
+                eigen.eigenvectors * Matrix2::from_diagonal(&axes) * eigen.eigenvectors.transpose();
+            let got = with_semi_axes(&shape, |a| a + grown);
+            prop_assert!((got - expected).norm() < 1e-9 * (1.0 + expected.norm()), "{got} {expected}");
+        }
+
         /// Every point of the sum of two ellipses lies within their bound: sampled over both
         /// ellipses' boundaries, for ellipses of any size, thinness and direction.
         #[test]

@@ -269,7 +269,7 @@ fn core(
     let mut residuals: Vec<(f64, (usize, usize))> = pairs
         .iter()
         .zip(inliers)
-        .map(|((p, q), &pair)| (motion.separation(p, q).distance, pair))
+        .map(|(pair, &inlier)| (GrownPair::new(pair).separation(&motion).distance, inlier))
         .collect();
     residuals.sort_by(|a, b| a.0.total_cmp(&b.0));
     let distances: Vec<f64> = residuals.iter().map(|r| r.0).collect();
@@ -462,6 +462,47 @@ fn same_assignment(a: &[(usize, usize)], b: &[(usize, usize)]) -> bool {
 /// A point of the current station and its partner in the frame.
 type PointPair = ([f64; 2], [f64; 2]);
 
+/// A placement of the current station and its partner in the frame, each grown by half the
+/// registration's slack once (turning a placement does not change its growth), for testing
+/// motions against them.
+struct GrownPair {
+    p: [f64; 2],
+    grown_p: Matrix2<f64>,
+    q: [f64; 2],
+    grown_q: Matrix2<f64>,
+}
+
+impl GrownPair {
+    fn new((p, q): &(Placed, Placed)) -> GrownPair {
+        GrownPair {
+            p: p.point,
+            grown_p: p.grown(0.5 * SLACK_M),
+            q: q.point,
+            grown_q: q.grown(0.5 * SLACK_M),
+        }
+    }
+
+    /// Where `motion` leaves `p` from `q`.
+    fn offset(&self, motion: &Motion) -> Vector2<f64> {
+        let moved = motion.apply(self.p);
+        Vector2::new(moved[0] - self.q[0], moved[1] - self.q[1])
+    }
+
+    /// The ellipse bounding both grown placements' sum, `p`'s turned by `motion`.
+    fn gate(&self, motion: &Motion) -> Matrix2<f64> {
+        let rotation = Matrix2::new(motion.cos, -motion.sin, motion.sin, motion.cos);
+        bound_of_sum(
+            &(rotation * self.grown_p * rotation.transpose()),
+            &self.grown_q,
+        )
+    }
+
+    /// [`Motion::separation`] of the pair.
+    fn separation(&self, motion: &Motion) -> Separation {
+        separation_of(self.offset(motion), &self.gate(motion))
+    }
+}
+
 /// Rotation by `angle` then translation.
 pub(super) struct Motion {
     cos: f64,
@@ -532,22 +573,14 @@ impl Motion {
     pub(super) fn fit(pairs: &[(Placed, Placed)]) -> Motion {
         let points: Vec<PointPair> = pairs.iter().map(|(p, q)| (p.point, q.point)).collect();
         let mut motion = Motion::procrustes(&points);
-        // The slack grows each placement once; turning does not change it.
-        let grown: Vec<(Matrix2<f64>, Matrix2<f64>)> = pairs
-            .iter()
-            .map(|(p, q)| (p.grown(0.5 * SLACK_M), q.grown(0.5 * SLACK_M)))
-            .collect();
+        let grown: Vec<GrownPair> = pairs.iter().map(GrownPair::new).collect();
         for _ in 0..FIT_ITERATIONS {
-            let rotation = Matrix2::new(motion.cos, -motion.sin, motion.sin, motion.cos);
             let (mut normal, mut gradient) = (Matrix3::zeros(), Vector3::zeros());
-            for ((p, q), (gp, gq)) in points.iter().zip(&grown) {
-                let Some(weight) =
-                    bound_of_sum(&(rotation * gp * rotation.transpose()), gq).try_inverse()
-                else {
+            for pair in &grown {
+                let Some(weight) = pair.gate(&motion).try_inverse() else {
                     continue;
                 };
-                let moved = motion.apply(*p);
-                let residual = Vector2::new(moved[0] - q[0], moved[1] - q[1]);
+                let (p, residual) = (pair.p, pair.offset(&motion));
                 // ∂ residual / ∂ (angle, shift x, shift y).
                 let (x, y) = (p[0], p[1]);
                 let jacobian = Matrix2x3::new(
@@ -599,7 +632,10 @@ impl Motion {
                 return None;
             }
             let motion = Motion::fit(&pairs);
-            let excess = |(p, q): &(Placed, Placed)| misfit(&motion, *p, *q);
+            let excess = |pair: &(Placed, Placed)| {
+                let separation = GrownPair::new(pair).separation(&motion);
+                separation.distance - separation.gate
+            };
             let worst = (0..pairs.len())
                 .max_by(|&a, &b| excess(&pairs[a]).total_cmp(&excess(&pairs[b])))?;
             if excess(&pairs[worst]) <= 0.0 {
@@ -615,10 +651,11 @@ impl Motion {
     /// on those pairs ([`Motion::fit`]). Unlike [`Motion::consensus`] a pair that is off does
     /// not pull the fit: it never takes part in it. None when fewer than `fewest` pairs agree.
     pub(super) fn agreed(pairs: &[(Placed, Placed)], fewest: usize) -> Option<Vec<bool>> {
+        let grown: Vec<GrownPair> = pairs.iter().map(GrownPair::new).collect();
         let agreeing = |motion: &Motion| -> Vec<bool> {
-            pairs
+            grown
                 .iter()
-                .map(|&(p, q)| misfit(motion, p, q) <= 0.0)
+                .map(|pair| pair.separation(motion).within())
                 .collect()
         };
         let count = |agree: &[bool]| agree.iter().filter(|&&a| a).count();

@@ -173,6 +173,11 @@ pub struct Detection {
     /// blob ends where the raised pixels do.
     #[serde(default)]
     pub beyond_columns: [u32; 2],
+    /// For a part separated by parallax, the range of its pixels' left–right shifts
+    /// (columns, the 10th–90th percentile): its own stereo evidence, which the other
+    /// panorama's blob, holding both parts, cannot give.
+    #[serde(default)]
+    pub parallax_shifts: Option<[f64; 2]>,
 }
 
 /// Statistics that change little with viewpoint, for associating a rock across panoramas.
@@ -333,17 +338,18 @@ fn detect_in(
                 None => vec![parallax::Layer {
                     pixels: c,
                     part: Separation::Whole,
+                    shifts: None,
                 }],
             };
             layers.into_iter().map(move |layer| (blob as u32, layer))
         })
         .flat_map_iter(|(blob, layer)| {
-            let part = layer.part;
+            let (part, shifts) = (layer.part, layer.shifts);
             pieces(layer, rule)
                 .into_iter()
-                .map(move |piece| (blob, piece, part))
+                .map(move |piece| (blob, piece, part, shifts))
         })
-        .filter_map(|(blob, piece, part)| {
+        .filter_map(|(blob, piece, part, shifts)| {
             let pixels = blob_of(&piece.pixels, w, &sample);
             let mut detection = accept(pixels, piece.ambiguous || doubted, top, calib, settings)?;
             if stances.is_some() {
@@ -357,6 +363,7 @@ fn detect_in(
                 detection.ambiguous |= rows < doubt;
             }
             detection.separation = part;
+            detection.parallax_shifts = shifts.map(|s| s.map(f64::from));
             detection.blob = blob;
             Some(detection)
         })
@@ -756,6 +763,7 @@ fn accept(
         separation: Separation::Whole,
         blob: 0,
         beyond_columns: [0, 0],
+        parallax_shifts: None,
     })
 }
 

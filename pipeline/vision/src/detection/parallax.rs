@@ -86,6 +86,24 @@ const MAX_WORK: usize = 1 << 27;
 pub(super) struct Layer {
     pub pixels: Component,
     pub part: Separation,
+    /// For a separated part, the [`SHIFT_QUANTILES`] of its pixels' reliable shifts (columns):
+    /// its own stereo evidence, since the other panorama's blob holds both parts.
+    pub shifts: Option<[f32; 2]>,
+}
+
+/// The quantiles of a separated part's pixel shifts taken as its range of shifts: the
+/// matching's outliers (windows straddling the occluding edge) lie beyond them.
+const SHIFT_QUANTILES: [f64; 2] = [0.1, 0.9];
+
+/// The [`SHIFT_QUANTILES`] of `shifts`' reliable values, if it has any.
+fn shift_range(shifts: &[Option<f32>]) -> Option<[f32; 2]> {
+    let mut reliable: Vec<f32> = shifts.iter().flatten().copied().collect();
+    if reliable.is_empty() {
+        return None;
+    }
+    reliable.sort_by(f32::total_cmp);
+    let at = |q: f64| reliable[((reliable.len() - 1) as f64 * q).round() as usize];
+    Some([at(SHIFT_QUANTILES[0]), at(SHIFT_QUANTILES[1])])
 }
 
 /// The layers of `pixels` (unwrapped columns); one layer if the blob is at one range.
@@ -108,6 +126,7 @@ pub(super) fn layers(
         return vec![Layer {
             pixels,
             part: Separation::Whole,
+            shifts: None,
         }];
     }
     let shifts = pixel_shifts(&pixels, partner, max_shift, rule.radius);
@@ -121,8 +140,13 @@ pub(super) fn layers(
         };
         let Some(labels) = labels else {
             if depth == 0 {
-                out.push(Layer { pixels, part });
+                out.push(Layer {
+                    pixels,
+                    part,
+                    shifts: None,
+                });
             } else {
+                let range = shift_range(&shifts);
                 // A separated layer may come apart; its slivers (window-sized runs along the
                 // other layer's edge) are dropped rather than reported as rocks.
                 let parts = connected(&pixels);
@@ -133,7 +157,11 @@ pub(super) fn layers(
                     parts
                         .into_iter()
                         .filter(|p| p.len() >= keep)
-                        .map(|pixels| Layer { pixels, part }),
+                        .map(|pixels| Layer {
+                            pixels,
+                            part,
+                            shifts: range,
+                        }),
                 );
             }
             continue;

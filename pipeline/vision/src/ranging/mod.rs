@@ -175,7 +175,9 @@ pub fn observe(
             });
             let ground = ground_cue(d, i, primary, calib, model, reach_width, half_baseline);
             let right_detection = matches[i].zip(right).map(|(j, r)| &r[j]);
-            let stereo = right_detection.map(|r| stereo_cue(d, r, calib, model));
+            let stereo = right_detection
+                .map(|r| stereo_cue(d, r, calib, model))
+                .or_else(|| parallax_cue(d, calib, model, reach_width));
             let (fused, conflict) = fuse([ground, stereo, None]);
             // The ray is where the detection itself was seen; a piece's bearing takes in the
             // columns it may reach over.
@@ -379,6 +381,33 @@ fn stereo_cue(
     RangeInterval::new(near, far)
 }
 
+/// Stereo cue of a part of a blob separated by parallax, which has no partner in the other
+/// panorama (its blob there holds both parts): its own pixels' shifts put its visible surface
+/// between the ranges of their 10th and 90th percentiles, give or take the matching error, and
+/// the reference point lies beyond that surface by at most `reach_per_width` of the width the
+/// rock may have (`angular_width`, taking in a neighbour it may reach under), as for the
+/// ground cue. `None` for a detection without such shifts.
+fn parallax_cue(
+    d: &Detection,
+    calib: &Calibration,
+    model: &SensorModel,
+    angular_width: f64,
+) -> Option<RangeInterval> {
+    let [low, high] = d.parallax_shifts?;
+    let k = model.reach_per_width * angular_width;
+    if k >= 1.0 {
+        return None;
+    }
+    let disparity = |shift: f64| shift * calib.column_width();
+    let near = calib
+        .stereo_range(disparity(high + model.disparity_error_px))
+        .unwrap_or(0.0);
+    let far = calib
+        .stereo_range(disparity(low - model.disparity_error_px))
+        .unwrap_or(f64::INFINITY);
+    Some(RangeInterval::new(near, far / (1.0 - k)))
+}
+
 /// Bearing from the station centre, and the ray the detection was seen along. Left eye:
 /// α_L = φ − asin(b/2d) and α_R = φ + asin(b/2d), so a stereo pair gives φ as their mean; a
 /// lone left detection gives φ within the offsets its range interval allows.
@@ -483,6 +512,7 @@ mod tests {
             separation,
             blob: 7,
             beyond_columns: [0, 0],
+            parallax_shifts: None,
         }
     }
 

@@ -105,7 +105,9 @@ impl Default for Association {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Exclusion {
-    /// Behind a nearer rock it was told apart from by parallax, which may hide some of it.
+    /// Behind a nearer rock it was told apart from by parallax, which may hide some of it:
+    /// written by runs before such parts were used (stop 35), and kept so that their
+    /// `stations.json` still reads.
     Behind,
     /// The detector doubts it is one whole rock: a piece cut at a shallow notch, a top
     /// without its body, or no stereo to tell it from a shadow.

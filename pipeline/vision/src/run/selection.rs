@@ -29,7 +29,13 @@ pub(crate) fn usable(station: &StationDetections, ranged: &[Ranged], width: u32)
 /// several rocks, or part of one), slivers, stacks, pieces touching another in luminance mode,
 /// and those whose bearing is too uncertain to measure with. In colour mode pieces touching
 /// another are used, with their bearings and ranges widened over the neighbour
-/// ([`Ranged::piece`]), but found no landmark.
+/// ([`Ranged::piece`]), but found no landmark. The farther part of a blob separated by
+/// parallax is used though the detector doubts it: the nearer part may hide some of it, which
+/// its bearing (over the nearer part's columns, as a piece's) and its range (its own pixels'
+/// shifts, taking in the rock's reach) allow for. On marsyard seed 7, eval's stereo cue
+/// intervals went from 587 to 1 023 (the separated parts'), all holding the truth, 99.9 % of
+/// the used bearings held it as before, and the fused share of correct detections rose from
+/// 55.2 % to 63.4 %.
 pub(super) fn exclusion(
     station: &StationDetections,
     ranged: &[Ranged],
@@ -37,9 +43,7 @@ pub(super) fn exclusion(
     width: u32,
 ) -> Option<Exclusion> {
     let d = &station.primary[i];
-    if d.ambiguous && d.separation == Separation::Farther {
-        Some(Exclusion::Behind)
-    } else if d.ambiguous {
+    if d.ambiguous && d.separation != Separation::Farther {
         Some(Exclusion::Doubted)
     } else if d.bbox[2] + 1 < d.bbox[0] + MIN_COLUMNS.max(width / 512) {
         Some(Exclusion::Sliver)
@@ -159,6 +163,7 @@ mod tests {
             separation,
             blob: 0,
             beyond_columns: [0, 0],
+            parallax_shifts: None,
         }
     }
 
@@ -184,7 +189,8 @@ mod tests {
     }
 
     /// Each detection left out says why, and only those left out are not usable; pieces
-    /// touching each other are used in colour mode only.
+    /// touching each other are used in colour mode only, a farther part of a blob separated by
+    /// parallax in both.
     #[test]
     fn every_left_out_detection_has_its_reason() {
         let primary = vec![
@@ -216,7 +222,7 @@ mod tests {
             reasons,
             [
                 None,
-                Some(Exclusion::Behind),
+                None,
                 Some(Exclusion::Doubted),
                 Some(Exclusion::Sliver),
                 Some(Exclusion::Stacked),
@@ -225,7 +231,7 @@ mod tests {
                 Some(Exclusion::WideBearing),
             ]
         );
-        assert_eq!(usable(&station, &all, 4096), [0, 5, 6]);
+        assert_eq!(usable(&station, &all, 4096), [0, 1, 5, 6]);
         // By luminance, the pieces touching each other are left out.
         let station = StationDetections {
             channels: Channels::Luminance,
@@ -235,6 +241,6 @@ mod tests {
             .map(|i| exclusion(&station, &all, i, 4096))
             .collect();
         assert_eq!(reasons, [Some(Exclusion::Touching); 2]);
-        assert_eq!(usable(&station, &all, 4096), [0]);
+        assert_eq!(usable(&station, &all, 4096), [0, 1]);
     }
 }
