@@ -642,6 +642,20 @@ mod tests {
             }
             let parts: Vec<Separation> = layers.iter().map(|l| l.part).collect();
             assert!(parts.contains(&Separation::Nearer) && parts.contains(&Separation::Farther));
+            // Each layer's shifts are its own rock's, within a column of matching error.
+            for layer in &layers {
+                let [low, high] = layer.shifts.expect("a separated layer has shifts");
+                let own = if layer.part == Separation::Farther {
+                    10.0
+                } else {
+                    16.0
+                };
+                assert!(
+                    (own - 1.0..=own + 1.0).contains(&low) && (low..=own + 1.0).contains(&high),
+                    "{:?}: shifts {low}–{high}, its rock's {own}",
+                    layer.part
+                );
+            }
         }
     }
 
@@ -658,6 +672,10 @@ mod tests {
         let n = pixels.len();
         let whole = layers(pixels.clone(), &partner(&own, &other, 1), 25, rule());
         assert_eq!(whole.len(), 1);
+        assert_eq!(
+            whole[0].shifts, None,
+            "a whole blob has a stereo partner instead"
+        );
         assert_eq!(whole[0].pixels.len(), n);
         assert_eq!(whole[0].part, Separation::Whole);
         // The step rule alone keeps it whole.
