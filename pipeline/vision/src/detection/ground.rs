@@ -120,9 +120,16 @@ fn window_costs(a: &[f32], b: &[f32], width: usize, offset: isize) -> Vec<f32> {
     let rows = a.len() / width;
     let mut column_sums = vec![0f32; width];
     let start = offset.rem_euclid(width as isize) as usize;
+    let split = width - start;
     for (ra, rb) in a.chunks_exact(width).zip(b.chunks_exact(width)) {
-        let shifted = rb[start..].iter().chain(&rb[..start]);
-        for ((sum, p), q) in column_sums.iter_mut().zip(ra).zip(shifted) {
+        // Column x of `a` against column x + start of `b`, wrapping at the seam: two
+        // contiguous runs, which compile to vector instructions (one chained run did not).
+        let (sums_before, sums_after) = column_sums.split_at_mut(split);
+        let (ra_before, ra_after) = ra.split_at(split);
+        for ((sum, p), q) in sums_before.iter_mut().zip(ra_before).zip(&rb[start..]) {
+            *sum += (p - q).abs();
+        }
+        for ((sum, p), q) in sums_after.iter_mut().zip(ra_after).zip(&rb[..start]) {
             *sum += (p - q).abs();
         }
     }
@@ -199,14 +206,25 @@ fn ground_shift(calib: &Calibration, row: f64) -> f64 {
 
 /// Sums of `2·RADIUS + 1` consecutive values around each column, wrapping at the seam.
 fn window_sums(values: &[f32]) -> Vec<f32> {
-    let w = values.len() as isize;
-    let at = |x: isize| values[x.rem_euclid(w) as usize];
-    let r = RADIUS as isize;
-    let mut sum: f32 = (-r..=r).map(at).sum();
+    let w = values.len();
+    let at = |x: isize| values[x.rem_euclid(w as isize) as usize];
+    let r = RADIUS;
+    let mut sum: f32 = (-(r as isize)..=r as isize).map(at).sum();
+    // Indices wrap only near the seam; elsewhere they index directly (no division a column).
     (0..w)
         .map(|x| {
             let out = sum;
-            sum += at(x + r + 1) - at(x - r);
+            let entering = if x + r + 1 < w {
+                values[x + r + 1]
+            } else {
+                at((x + r + 1) as isize)
+            };
+            let leaving = if x >= r {
+                values[x - r]
+            } else {
+                at(x as isize - r as isize)
+            };
+            sum += entering - leaving;
             out
         })
         .collect()
