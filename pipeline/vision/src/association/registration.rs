@@ -9,7 +9,7 @@
 //! mutual distances agree; the one with most consistent correspondences wins. This only
 //! *proposes*: the qualitative test of 000 §VI-C decides (`super::associate`).
 
-use super::placement::{bound_of_sum, separation, separation_of, Placed, Separation};
+use super::placement::{bound_of_sum, separation_of, Placed, Separation};
 use super::significance::Chance;
 use crate::ranging::Ray;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
@@ -406,10 +406,11 @@ impl Registration {
 /// 002's probabilistic map, which a rover without odometry does not have. `None` when too few
 /// landmarks agree, or when the station moved less than twice the shift's s.d.
 ///
-/// The s.d. is the least-squares one, from the scatter the fit leaves. The placements' ellipses
-/// bound their errors and overstate them about eightfold; against the true headings of five
-/// rendered drives (marsyard seed 7, half-resolution marsyard seed 3 and random seed 5,
-/// `sparse-large` seed 3, the demo), errors over this s.d. had an r.m.s. of 0.85–0.96.
+/// The s.d. is the least-squares one, from the scatter the fit leaves. The placements bound
+/// their errors and, as discs, overstated them about eightfold; against the true headings of
+/// five rendered drives (marsyard seed 7, half-resolution marsyard seed 3 and random seed 5,
+/// `sparse-large` seed 3, the demo), errors over this s.d. had an r.m.s. of 0.85–0.96 while
+/// placements were discs fitted on their points alone (not measured since).
 pub fn displacement(earlier: &Frame, later: &Frame) -> Option<(f64, f64)> {
     let pairs: Vec<(Placed, Placed)> = later
         .landmarks
@@ -614,7 +615,7 @@ impl Motion {
     /// How far apart the motion leaves the placement `p` and the frame's `q` (with the
     /// registration's slack).
     pub(super) fn separation(&self, p: &Placed, q: &Placed) -> Separation {
-        separation(&self.apply_placed(p), q, SLACK_M)
+        GrownPair::new(&(*p, *q)).separation(self)
     }
 
     /// The placement `p` of the current station in the frame's coordinates.
@@ -632,10 +633,7 @@ impl Motion {
                 return None;
             }
             let motion = Motion::fit(&pairs);
-            let excess = |pair: &(Placed, Placed)| {
-                let separation = GrownPair::new(pair).separation(&motion);
-                separation.distance - separation.gate
-            };
+            let excess = |&(p, q): &(Placed, Placed)| misfit(&motion, p, q);
             let worst = (0..pairs.len())
                 .max_by(|&a, &b| excess(&pairs[a]).total_cmp(&excess(&pairs[b])))?;
             if excess(&pairs[worst]) <= 0.0 {
@@ -821,6 +819,7 @@ pub(super) fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
+    use crate::association::placement::separation;
 
     /// Six rocks around a station, metres apart (also the association tests' field).
     pub(in crate::association) const FIELD: [[f64; 2]; 6] = [
