@@ -229,6 +229,15 @@ pub fn associate<C: Calculus>(
     // stations 62–66: 4-pair fits left with 1 or 2 pairs anchored rocks 15–59 m from their
     // landmarks' own).
     registrations.retain(|(_, registration)| registration.pairs.len() >= MIN_INLIERS);
+    // Nor is a registration of any size whose fit chance explains (NFA 1 or more: as many fits
+    // as tight are expected from the hypotheses tried), alone or not: consecutive stations'
+    // frames share most of their landmarks, so one chance fit of look-alikes is found in both
+    // (the 1 000-rock drive, station 22: two 4-pair fits at NFA 462 and 1 088 gave four
+    // landmarks a second rock, 985 unsound relations; such fits were dropped only when alone
+    // until stop 35). Earlier: station 12's only registration, 7 pairs against the sketch
+    // at NFA 1.5 × 10⁴, paired six landmarks with the wrong rocks, in an experiment with
+    // unranged detections counted in the eye's direction.
+    registrations.retain(|(_, registration)| registration.nfa < 1.0);
     let registrations = believed(registrations, frames);
     let min_support = if station.colour {
         1
@@ -391,12 +400,6 @@ fn believed<'f>(
         {
             Vec::new()
         }
-        // Nor is a station's only registration of any size whose fit chance explains: as many
-        // fits as tight are expected from the hypotheses tried. (Seen on the 1 000-rock drive
-        // with unranged detections counted in the eye's direction, an experiment not kept:
-        // station 12's only registration, 7 pairs against the sketch at NFA 1.5 × 10⁴, paired
-        // six landmarks with the wrong rocks, 1 983 unsound relations.)
-        [(_, registration)] if registration.nfa >= 1.0 => Vec::new(),
         _ => registrations,
     }
 }
