@@ -229,15 +229,6 @@ pub fn associate<C: Calculus>(
     // stations 62–66: 4-pair fits left with 1 or 2 pairs anchored rocks 15–59 m from their
     // landmarks' own).
     registrations.retain(|(_, registration)| registration.pairs.len() >= MIN_INLIERS);
-    // Nor is a registration of any size whose fit chance explains (NFA 1 or more: as many fits
-    // as tight are expected from the hypotheses tried), alone or not: consecutive stations'
-    // frames share most of their landmarks, so one chance fit of look-alikes is found in both
-    // (the 1 000-rock drive, station 22: two 4-pair fits at NFA 462 and 1 088 gave four
-    // landmarks a second rock, 985 unsound relations; such fits were dropped only when alone
-    // until stop 35). Earlier: station 12's only registration, 7 pairs against the sketch
-    // at NFA 1.5 × 10⁴, paired six landmarks with the wrong rocks, in an experiment with
-    // unranged detections counted in the eye's direction.
-    registrations.retain(|(_, registration)| registration.nfa < 1.0);
     let registrations = believed(registrations, frames);
     let min_support = if station.colour {
         1
@@ -370,14 +361,24 @@ fn registrations<'f>(
         .collect()
 }
 
-/// The registrations less a station's only one when it is not believed. Applied once the
+/// The registrations less those whose fit chance explains, and less a station's only one when
+/// it is not believed. Applied once the
 /// pairs seen elsewhere are dropped: a registration dropped then leaves another alone (the
 /// 1 000-rock drive, station 380: a 4-pair fit of NFA 0.8, the lone survivor of two, paired
 /// four detections with rocks 19–31 m from their landmarks' own; 144 unsound relations).
 fn believed<'f>(
-    registrations: Vec<(&'f Frame, Registration)>,
+    mut registrations: Vec<(&'f Frame, Registration)>,
     frames: &[Frame],
 ) -> Vec<(&'f Frame, Registration)> {
+    // No registration of any size whose fit chance explains (NFA 1 or more: as many fits as
+    // tight are expected from the hypotheses tried) is believed, alone or not: consecutive
+    // stations' frames share most of their landmarks, so one chance fit of look-alikes is
+    // found in both (the 1 000-rock drive, station 22: two 4-pair fits at NFA 462 and 1 088
+    // gave four landmarks a second rock, 985 unsound relations; such fits were dropped only
+    // when alone until stop 35). Earlier: station 12's only registration, 7 pairs against the
+    // sketch at NFA 1.5 × 10⁴, paired six landmarks with the wrong rocks, in an experiment
+    // with unranged detections counted in the eye's direction.
+    registrations.retain(|(_, registration)| registration.nfa < 1.0);
     // A station's only registration is a chance fit of look-alikes when several other frames
     // hold enough of its landmarks to have found the same pairing and none did.
     match registrations.as_slice() {
@@ -907,9 +908,10 @@ mod tests {
     }
 
     /// A lone registration of many pairs needs no small NFA, but one that chance explains
-    /// (NFA ≥ 1: as many fits as tight expected from the hypotheses tried) is not believed.
+    /// (NFA ≥ 1: as many fits as tight expected from the hypotheses tried) is not believed,
+    /// alone or beside another.
     #[test]
-    fn a_lone_registration_that_chance_explains_is_not_believed_whatever_its_size() {
+    fn a_registration_that_chance_explains_is_not_believed_whatever_its_size() {
         let (only, other) = (frame(&FIELD), frame(&FIELD[..1]));
         let large = |nfa: f64| Registration {
             pairs: (0..6).map(|l| (l, l as LandmarkId)).collect(),
@@ -921,15 +923,16 @@ mod tests {
         };
         assert_eq!(left(large(0.5)), 1);
         assert_eq!(left(large(1.5e4)), 0);
-        assert_eq!(
-            believed(
-                vec![(&only, large(1.5e4)), (&other, large(0.5))],
-                &[only.clone(), other.clone()]
-            )
-            .len(),
-            2,
-            "beside another registration it is judged with it"
+        let kept = believed(
+            vec![(&only, large(1.5e4)), (&other, large(0.5))],
+            &[only.clone(), other.clone()],
         );
+        assert_eq!(
+            kept.len(),
+            1,
+            "beside another registration it is dropped too"
+        );
+        assert_eq!(kept[0].1.nfa, 0.5);
     }
 
     #[test]
