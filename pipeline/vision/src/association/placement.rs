@@ -59,12 +59,11 @@ impl Placed {
         semi_axes(&self.shape)[1]
     }
 
-    /// The placement turned by the rotation `[cos, sin]` and moved to `point`.
-    pub(super) fn turned(&self, [cos, sin]: [f64; 2], point: [f64; 2]) -> Placed {
-        let rotation = Matrix2::new(cos, -sin, sin, cos);
+    /// The placement turned by the rotation `turn` (`[cos, sin]`) and moved to `point`.
+    pub(super) fn turned(&self, turn: [f64; 2], point: [f64; 2]) -> Placed {
         Placed {
             point,
-            shape: rotation * self.shape * rotation.transpose(),
+            shape: turned_shape(&self.shape, turn),
         }
     }
 
@@ -143,6 +142,12 @@ pub(super) fn bound_of_sum(a: &Matrix2<f64>, b: &Matrix2<f64>) -> Matrix2<f64> {
     }
     let t = (ta / tb).sqrt();
     a * (1.0 + 1.0 / t) + b * (1.0 + t)
+}
+
+/// The ellipse `shape` turned by the rotation `[cos, sin]`.
+pub(super) fn turned_shape(shape: &Matrix2<f64>, [cos, sin]: [f64; 2]) -> Matrix2<f64> {
+    let rotation = Matrix2::new(cos, -sin, sin, cos);
+    rotation * shape * rotation.transpose()
 }
 
 /// The semi-axes of an ellipse, shortest first.

@@ -9,7 +9,7 @@
 //! mutual distances agree; the one with most consistent correspondences wins. This only
 //! *proposes*: the qualitative test of 000 §VI-C decides (`super::associate`).
 
-use super::placement::{bound_of_sum, separation_of, Placed, Separation};
+use super::placement::{bound_of_sum, separation_of, turned_shape, Placed, Separation};
 use super::significance::Chance;
 use crate::ranging::Ray;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
@@ -491,9 +491,8 @@ impl GrownPair {
 
     /// The ellipse bounding both grown placements' sum, `p`'s turned by `motion`.
     fn gate(&self, motion: &Motion) -> Matrix2<f64> {
-        let rotation = Matrix2::new(motion.cos, -motion.sin, motion.sin, motion.cos);
         bound_of_sum(
-            &(rotation * self.grown_p * rotation.transpose()),
+            &turned_shape(&self.grown_p, [motion.cos, motion.sin]),
             &self.grown_q,
         )
     }
@@ -761,7 +760,6 @@ impl Candidates {
 /// brings within tolerance, and the fit score Σ (1 − (distance / gate)²).
 fn matches(candidates: &Candidates, motion: &Motion) -> (Vec<(usize, usize)>, f64) {
     let n = candidates.x.len();
-    let rotation = Matrix2::new(motion.cos, -motion.sin, motion.sin, motion.cos);
     let mut close: Vec<(f64, usize, usize, f64)> = Vec::new();
     for (row, &(i, point, grown, reach)) in candidates.detections.iter().enumerate() {
         let [mx, my] = motion.apply(point);
@@ -775,7 +773,8 @@ fn matches(candidates: &Candidates, motion: &Motion) -> (Vec<(usize, usize)>, f6
             if dx * dx + dy * dy > bound * bound * (1.0 + 1e-9) {
                 continue;
             }
-            let turned = *turned.get_or_insert_with(|| rotation * grown * rotation.transpose());
+            let turned =
+                *turned.get_or_insert_with(|| turned_shape(&grown, [motion.cos, motion.sin]));
             let separation = separation_of(
                 Vector2::new(dx, dy),
                 &bound_of_sum(&turned, &candidates.grown[j]),

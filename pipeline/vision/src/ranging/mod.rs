@@ -279,13 +279,19 @@ fn ground_cue(
     // Range from the eye along the view, then from the station centre (the eye sits half a
     // baseline across the view).
     let centre = |r: f64| r.hypot(half_baseline);
-    // The reference point lies beyond the contact by ≤ reach·width, and the width itself
-    // grows with range: width ≤ angular_width · range.
+    Some(RangeInterval::new(
+        centre(near),
+        beyond_reach(centre(far), model, angular_width)?,
+    ))
+}
+
+/// The far end of a cue for the rock's reference point, which lies beyond the visible
+/// surface (its contact, its face) at `far` by at most `reach_per_width` of its width, the
+/// width itself growing with range (≤ `angular_width` · range): `far / (1 − k)`, none when
+/// `k = reach_per_width · angular_width` is 1 or more.
+fn beyond_reach(far: f64, model: &SensorModel, angular_width: f64) -> Option<f64> {
     let k = model.reach_per_width * angular_width;
-    if k >= 1.0 {
-        return None;
-    }
-    Some(RangeInterval::new(centre(near), centre(far) / (1.0 - k)))
+    (k < 1.0).then(|| far / (1.0 - k))
 }
 
 /// Whether detection `index` touches another one side by side (columns within two of each
@@ -394,10 +400,6 @@ fn parallax_cue(
     angular_width: f64,
 ) -> Option<RangeInterval> {
     let [low, high] = d.parallax_shifts?;
-    let k = model.reach_per_width * angular_width;
-    if k >= 1.0 {
-        return None;
-    }
     let disparity = |shift: f64| shift * calib.column_width();
     let near = calib
         .stereo_range(disparity(high + model.disparity_error_px))
@@ -405,7 +407,10 @@ fn parallax_cue(
     let far = calib
         .stereo_range(disparity(low - model.disparity_error_px))
         .unwrap_or(f64::INFINITY);
-    Some(RangeInterval::new(near, far / (1.0 - k)))
+    Some(RangeInterval::new(
+        near,
+        beyond_reach(far, model, angular_width)?,
+    ))
 }
 
 /// Bearing from the station centre, and the ray the detection was seen along. Left eye:
