@@ -46,16 +46,14 @@ impl Interval {
         Interval { lo, hi }
     }
 
+    /// The products of `self`, which holds no negative number (a range, a sum or product of
+    /// ranges), with `k`: the extremes are `k`'s ends times whichever of `self`'s ends the sign
+    /// of that end picks, the same products the four-corner rule takes.
     fn scale(self, k: Interval) -> Interval {
-        let p = [
-            self.lo * k.lo,
-            self.lo * k.hi,
-            self.hi * k.lo,
-            self.hi * k.hi,
-        ];
+        debug_assert!(self.lo >= 0.0, "scale of an interval reaching below zero");
         Interval::new(
-            p.iter().copied().fold(f64::INFINITY, f64::min),
-            p.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            k.lo * if k.lo >= 0.0 { self.lo } else { self.hi },
+            k.hi * if k.hi >= 0.0 { self.hi } else { self.lo },
         )
     }
 
@@ -233,7 +231,7 @@ fn boundary(
         0 => ra.scale(rb).scale(sin_ab) + rc.scale(rb.scale(sin_bc) + ra.scale(sin_ca)),
         1 => ra.scale(ra - rb.scale(cos_ab)) + rc.scale(towards_c()),
         2 => rb.scale(ra.scale(cos_ab) - rb) + rc.scale(towards_c()),
-        3 => (ra - rb).scale(ra + rb) + twice(rc.scale(towards_c())),
+        3 => (ra + rb).scale(ra - rb) + twice(rc.scale(towards_c())),
         4 => rc.scale(rc - twice(ra.scale(cos_ac))) + rb.scale(twice(ra.scale(cos_ab)) - rb),
         _ => rc.scale(rc - twice(rb.scale(cos_bc))) + ra.scale(twice(rb.scale(cos_ab)) - ra),
     }
