@@ -206,84 +206,116 @@ fn enclosures(
     turns: &[[(Interval, Interval); 3]; 3],
     order: [usize; 3],
 ) -> [Interval; 6] {
-    std::array::from_fn(|f| boundary(f, ranges, turns, order))
+    let labelled = Labelled::new(ranges, turns, order);
+    std::array::from_fn(|f| labelled.boundary(f))
 }
 
-/// Enclosure of boundary function `f` (see [`enclosures`]), written in the ranges and the
-/// cosines and sines of the turns between bearings, and grouped so that each range multiplies
-/// what it scales: expanded as differences of squared distances, a far landmark's range
-/// interval enters twice and its width swamps a value orders of magnitude smaller.
-fn boundary(
-    f: usize,
-    ranges: &[Interval; 3],
-    turns: &[[(Interval, Interval); 3]; 3],
-    [a, b, c]: [usize; 3],
-) -> Interval {
-    let (ra, rb, rc) = (ranges[a], ranges[b], ranges[c]);
-    let (cos_ab, sin_ab) = turns[a][b];
-    let (cos_bc, sin_bc) = turns[b][c];
-    let (cos_ac, _) = turns[a][c];
-    let (_, sin_ca) = turns[c][a];
-    let twice = |x: Interval| x + x;
-    // B·C − A·C, which three of the functions share.
-    let towards_c = || rb.scale(cos_bc) - ra.scale(cos_ac);
-    match f {
-        0 => ra.scale(rb).scale(sin_ab) + rc.scale(rb.scale(sin_bc) + ra.scale(sin_ca)),
-        1 => ra.scale(ra - rb.scale(cos_ab)) + rc.scale(towards_c()),
-        2 => rb.scale(ra.scale(cos_ab) - rb) + rc.scale(towards_c()),
-        3 => (ra + rb).scale(ra - rb) + twice(rc.scale(towards_c())),
-        4 => rc.scale(rc - twice(ra.scale(cos_ac))) + rb.scale(twice(ra.scale(cos_ab)) - rb),
-        _ => rc.scale(rc - twice(rb.scale(cos_bc))) + ra.scale(twice(rb.scale(cos_ab)) - ra),
+/// The ranges of A, B, C (`[a, b, c]` = indices into a box's ranges) and the cosines and sines
+/// of the turns between their bearings: what the boundary functions and their derivatives are
+/// written in.
+struct Labelled {
+    ra: Interval,
+    rb: Interval,
+    rc: Interval,
+    cos_ab: Interval,
+    sin_ab: Interval,
+    cos_bc: Interval,
+    sin_bc: Interval,
+    cos_ac: Interval,
+    sin_ca: Interval,
+}
+
+impl Labelled {
+    fn new(
+        ranges: &[Interval; 3],
+        turns: &[[(Interval, Interval); 3]; 3],
+        [a, b, c]: [usize; 3],
+    ) -> Labelled {
+        Labelled {
+            ra: ranges[a],
+            rb: ranges[b],
+            rc: ranges[c],
+            cos_ab: turns[a][b].0,
+            sin_ab: turns[a][b].1,
+            cos_bc: turns[b][c].0,
+            sin_bc: turns[b][c].1,
+            cos_ac: turns[a][c].0,
+            sin_ca: turns[c][a].1,
+        }
+    }
+
+    /// B·C − A·C, which three of the functions share.
+    fn towards_c(&self) -> Interval {
+        self.rb.scale(self.cos_bc) - self.ra.scale(self.cos_ac)
+    }
+
+    /// Enclosure of boundary function `f` (see [`enclosures`]), written in the ranges and the
+    /// cosines and sines of the turns between bearings, and grouped so that each range multiplies
+    /// what it scales: expanded as differences of squared distances, a far landmark's range
+    /// interval enters twice and its width swamps a value orders of magnitude smaller.
+    fn boundary(&self, f: usize) -> Interval {
+        let (ra, rb, rc) = (self.ra, self.rb, self.rc);
+        match f {
+            0 => {
+                ra.scale(rb).scale(self.sin_ab)
+                    + rc.scale(rb.scale(self.sin_bc) + ra.scale(self.sin_ca))
+            }
+            1 => ra.scale(ra - rb.scale(self.cos_ab)) + rc.scale(self.towards_c()),
+            2 => rb.scale(ra.scale(self.cos_ab) - rb) + rc.scale(self.towards_c()),
+            3 => (ra + rb).scale(ra - rb) + twice(rc.scale(self.towards_c())),
+            4 => {
+                rc.scale(rc - twice(ra.scale(self.cos_ac)))
+                    + rb.scale(twice(ra.scale(self.cos_ab)) - rb)
+            }
+            _ => {
+                rc.scale(rc - twice(rb.scale(self.cos_bc)))
+                    + ra.scale(twice(rb.scale(self.cos_ab)) - ra)
+            }
+        }
+    }
+
+    /// Enclosures of the derivatives of boundary function `f` in the ranges of A, B and C over
+    /// the box.
+    fn slopes(&self, f: usize) -> [Interval; 3] {
+        let (ra, rb, rc) = (self.ra, self.rb, self.rc);
+        match f {
+            0 => [
+                rb.scale(self.sin_ab) + rc.scale(self.sin_ca),
+                ra.scale(self.sin_ab) + rc.scale(self.sin_bc),
+                rb.scale(self.sin_bc) + ra.scale(self.sin_ca),
+            ],
+            1 => [
+                twice(ra) - rb.scale(self.cos_ab) - rc.scale(self.cos_ac),
+                rc.scale(self.cos_bc) - ra.scale(self.cos_ab),
+                self.towards_c(),
+            ],
+            2 => [
+                rb.scale(self.cos_ab) - rc.scale(self.cos_ac),
+                ra.scale(self.cos_ab) - twice(rb) + rc.scale(self.cos_bc),
+                self.towards_c(),
+            ],
+            3 => [
+                twice(ra - rc.scale(self.cos_ac)),
+                twice(rc.scale(self.cos_bc) - rb),
+                twice(self.towards_c()),
+            ],
+            4 => [
+                twice(rb.scale(self.cos_ab) - rc.scale(self.cos_ac)),
+                twice(ra.scale(self.cos_ab) - rb),
+                twice(rc - ra.scale(self.cos_ac)),
+            ],
+            _ => [
+                twice(rb.scale(self.cos_ab) - ra),
+                twice(ra.scale(self.cos_ab) - rc.scale(self.cos_bc)),
+                twice(rc - rb.scale(self.cos_bc)),
+            ],
+        }
     }
 }
 
-/// Enclosures of the derivatives of boundary function `f` in the ranges of A, B and C
-/// (`[a, b, c]` = `order`) over the box `ranges`.
-fn slopes(
-    f: usize,
-    ranges: &[Interval; 3],
-    turns: &[[(Interval, Interval); 3]; 3],
-    [a, b, c]: [usize; 3],
-) -> [Interval; 3] {
-    let (ra, rb, rc) = (ranges[a], ranges[b], ranges[c]);
-    let (cos_ab, sin_ab) = turns[a][b];
-    let (cos_bc, sin_bc) = turns[b][c];
-    let (cos_ac, _) = turns[a][c];
-    let (_, sin_ca) = turns[c][a];
-    let twice = |x: Interval| x + x;
-    let towards_c = || rb.scale(cos_bc) - ra.scale(cos_ac);
-    match f {
-        0 => [
-            rb.scale(sin_ab) + rc.scale(sin_ca),
-            ra.scale(sin_ab) + rc.scale(sin_bc),
-            rb.scale(sin_bc) + ra.scale(sin_ca),
-        ],
-        1 => [
-            twice(ra) - rb.scale(cos_ab) - rc.scale(cos_ac),
-            rc.scale(cos_bc) - ra.scale(cos_ab),
-            towards_c(),
-        ],
-        2 => [
-            rb.scale(cos_ab) - rc.scale(cos_ac),
-            ra.scale(cos_ab) - twice(rb) + rc.scale(cos_bc),
-            towards_c(),
-        ],
-        3 => [
-            twice(ra - rc.scale(cos_ac)),
-            twice(rc.scale(cos_bc) - rb),
-            twice(towards_c()),
-        ],
-        4 => [
-            twice(rb.scale(cos_ab) - rc.scale(cos_ac)),
-            twice(ra.scale(cos_ab) - rb),
-            twice(rc - ra.scale(cos_ac)),
-        ],
-        _ => [
-            twice(rb.scale(cos_ab) - ra),
-            twice(ra.scale(cos_ab) - rc.scale(cos_bc)),
-            twice(rc - rb.scale(cos_bc)),
-        ],
-    }
+/// `x + x`.
+fn twice(x: Interval) -> Interval {
+    x + x
 }
 
 /// `values` (the enclosures of [`enclosures`] over `ranges`) tightened where one straddles
@@ -304,7 +336,7 @@ fn tightened(
         if value.excludes_sign(1) || value.excludes_sign(-1) {
             return value;
         }
-        let slopes = slopes(f, ranges, turns, order);
+        let slopes = Labelled::new(ranges, turns, order).slopes(f);
         let (mut low, mut high) = (*ranges, *ranges);
         for (slope, &landmark) in slopes.iter().zip(&order) {
             let range = ranges[landmark];
@@ -319,8 +351,8 @@ fn tightened(
                 (low[landmark], high[landmark]) = (hi, lo);
             }
         }
-        let least = boundary(f, &low, turns, order).lo;
-        let greatest = boundary(f, &high, turns, order).hi;
+        let least = Labelled::new(&low, turns, order).boundary(f).lo;
+        let greatest = Labelled::new(&high, turns, order).boundary(f).hi;
         Interval::new(value.lo.max(least), value.hi.min(greatest))
     })
 }
