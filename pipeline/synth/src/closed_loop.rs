@@ -7,11 +7,13 @@
 //!
 //! What the navigator decides from: the panorama only. It never sees the world: the route,
 //! the headings, arrival and re-planning come from the map and the images. Two things use the
-//! world, and neither decides where to go: the renderer, and the hazard stop that stands in for
-//! a rover's own hazard cameras. A step that would end within [`CLEARANCE_M`] of a rock's
-//! footprint is turned by 20° at a time, alternately either way, up to 100°, to the first
-//! clear one (a rover's local avoidance); if none is clear the rover stays put for that step.
-//! A path segment that crosses a footprint anyway counts as a collision.
+//! world, and neither chooses where to go: the renderer, and the hazard avoidance that stands
+//! in for a rover's own hazard cameras ([`HazardAvoidance`]), which only decides how to drive
+//! each step on the commanded bearing. A step that would end within [`CLEARANCE_M`] of a
+//! rock's footprint is turned by 20° at a time, alternately either way, up to 100°; when every
+//! turn is blocked, the rover follows the shortest clear path around the rocks within a few
+//! metres, and keeps to it while the bearing holds. With no clear way the rover stays put for
+//! that step. A step that crosses a footprint anyway counts as a collision.
 //!
 //! The follower's cell is that of the nearest *identified* landmark (`navigation::cell_of`
 //! over them; the first of the possible ones when the order cannot tell), as in the
@@ -30,6 +32,7 @@
 //! judged against the truth only after the trip: the rover stopped in the goal landmark's
 //! Voronoi cell (the landmark whose rock is nearest to it).
 
+use crate::hazard_avoidance::HazardAvoidance;
 use crate::reference_path::shortest_path_m;
 use crate::render::{render, Eye, Pose};
 use crate::world::World;
@@ -49,6 +52,9 @@ use std::time::Instant;
 
 /// Nearest a step may end to a rock's footprint, metres (the rover's half-width and margin).
 pub const CLEARANCE_M: f64 = 0.3;
+/// How far a step may end from the straight step on the commanded bearing before it counts as
+/// avoiding a rock, metres.
+const AVOIDED_M: f64 = 0.01;
 /// Re-plans allowed when the next landmark of the route is lost from view.
 const REPLANS: usize = 5;
 /// Routes considered when re-planning.
@@ -97,7 +103,7 @@ pub struct Trip {
     pub path: Vec<[f64; 2]>,
     /// Steps whose segment crossed a rock's footprint.
     pub collisions: usize,
-    /// Steps the hazard stop turned or held.
+    /// Steps the hazard avoidance turned or held.
     pub avoided: usize,
     /// Seconds of navigator compute per step: detection to heading, rendering excluded.
     pub navigator_seconds: Vec<f64>,
@@ -139,7 +145,7 @@ pub struct StepLog {
     pub bearing_deg: Option<f64>,
     /// Re-plans so far.
     pub replans: usize,
-    /// The hazard stop turned or held this step.
+    /// The hazard avoidance turned or held this step.
     pub avoided: bool,
     /// Navigator compute of this step, seconds (detection to heading), and of it the
     /// detection in the stereo pair.
@@ -238,6 +244,7 @@ pub fn drive(
     // heading, so a bearing stays good for a few steps while its landmark is not identified.
     let mut last_seen: BTreeMap<LandmarkId, (f64, usize)> = BTreeMap::new();
     let mut approach = 0;
+    let mut avoidance = HazardAvoidance::default();
     for index in 0..driving.max_steps {
         let (left, right) = terrain.panoramas(pose);
         let started = Instant::now();
@@ -367,7 +374,14 @@ pub fn drive(
             break;
         };
         let avoided = trip.avoided;
-        let next = step(terrain, pose, bearing, driving.step_m, &mut trip);
+        let next = step(
+            terrain,
+            &mut avoidance,
+            pose,
+            bearing,
+            driving.step_m,
+            &mut trip,
+        );
         if let Some(log) = trip.steps.last_mut() {
             log.avoided = trip.avoided > avoided;
         }
@@ -403,35 +417,28 @@ fn replan(
         })
 }
 
-/// One step from `pose` toward `bearing` (the panorama's frame), turned away from rocks by the
-/// hazard stop; records avoidance and collisions in `trip`.
-fn step(terrain: &Terrain, pose: Pose, bearing: f64, length: f64, trip: &mut Trip) -> Point {
+/// One step from `pose` toward `bearing` (the panorama's frame), around the rocks in the way
+/// by the trip's `avoidance`; records avoidance and collisions in `trip`.
+fn step(
+    terrain: &Terrain,
+    avoidance: &mut HazardAvoidance,
+    pose: Pose,
+    bearing: f64,
+    length: f64,
+    trip: &mut Trip,
+) -> Point {
     let from = pose.position;
-    let toward = |turn: f64| {
-        let azimuth = pose.heading + bearing + turn;
-        Point::new(
-            from.x + length * azimuth.cos(),
-            from.y + length * azimuth.sin(),
-        )
-    };
-    let turns = [
-        0.0f64, 20.0, -20.0, 40.0, -40.0, 60.0, -60.0, 80.0, -80.0, 100.0, -100.0,
-    ];
-    let chosen = turns
-        .iter()
-        .map(|t| toward(t.to_radians()))
-        .position(|p| !terrain.blocked(p, CLEARANCE_M));
-    let next = match chosen {
-        Some(0) => toward(0.0),
-        Some(k) => {
-            trip.avoided += 1;
-            toward(turns[k].to_radians())
-        }
-        None => {
-            trip.avoided += 1;
-            from
-        }
-    };
+    let azimuth = pose.heading + bearing;
+    let straight = Point::new(
+        from.x + length * azimuth.cos(),
+        from.y + length * azimuth.sin(),
+    );
+    let next = avoidance
+        .drive(terrain.world, from, azimuth, length, CLEARANCE_M)
+        .unwrap_or(from);
+    if next.distance(straight) > AVOIDED_M {
+        trip.avoided += 1;
+    }
     if terrain.crosses(from, next) {
         trip.collisions += 1;
     }

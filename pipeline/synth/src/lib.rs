@@ -18,7 +18,9 @@ pub mod evaluation;
 pub mod reference_path;
 
 mod capture;
+mod clearance_grid;
 mod ellipsoid;
+mod hazard_avoidance;
 mod image_file;
 mod noise;
 mod render;

@@ -8,81 +8,13 @@
 //! may graze a clearance disc), the start is rounded to the grid, and a gap narrower than a
 //! cell may close. The reference is the true shortest path to within those approximations.
 
+use crate::clearance_grid::Grid;
 use crate::world::World;
 use pathfinding::directed::dijkstra::dijkstra;
 use qrm_core::geometry::Point;
 
-/// Grid spacing, metres.
-pub const RESOLUTION_M: f64 = 0.1;
 /// How far beyond the rocks and the start the grid reaches, metres.
 const BORDER_M: f64 = 3.0;
-
-/// Free space around the rocks of `world`, rasterized.
-struct Grid {
-    origin: Point,
-    width: i64,
-    height: i64,
-    free: Vec<bool>,
-}
-
-impl Grid {
-    fn new(world: &World, start: Point, clearance: f64) -> Grid {
-        let (mut low, mut high) = (start, start);
-        for r in &world.rocks {
-            low = Point::new(low.x.min(r.position.x), low.y.min(r.position.y));
-            high = Point::new(high.x.max(r.position.x), high.y.max(r.position.y));
-        }
-        let origin = Point::new(low.x - BORDER_M, low.y - BORDER_M);
-        let width = ((high.x - low.x + 2.0 * BORDER_M) / RESOLUTION_M).ceil() as i64 + 1;
-        let height = ((high.y - low.y + 2.0 * BORDER_M) / RESOLUTION_M).ceil() as i64 + 1;
-        let mut free = vec![true; (width * height) as usize];
-        for r in &world.rocks {
-            let reach = world.contact_radius(r.id) + clearance;
-            let (cx, cy) = (
-                (r.position.x - origin.x) / RESOLUTION_M,
-                (r.position.y - origin.y) / RESOLUTION_M,
-            );
-            let cells = (reach / RESOLUTION_M).ceil() as i64 + 1;
-            for y in (cy as i64 - cells).max(0)..=(cy as i64 + cells).min(height - 1) {
-                for x in (cx as i64 - cells).max(0)..=(cx as i64 + cells).min(width - 1) {
-                    let p = Point::new(
-                        origin.x + x as f64 * RESOLUTION_M,
-                        origin.y + y as f64 * RESOLUTION_M,
-                    );
-                    if p.distance(r.position) < reach {
-                        free[(y * width + x) as usize] = false;
-                    }
-                }
-            }
-        }
-        Grid {
-            origin,
-            width,
-            height,
-            free,
-        }
-    }
-
-    fn cell(&self, p: Point) -> (i64, i64) {
-        (
-            ((p.x - self.origin.x) / RESOLUTION_M).round() as i64,
-            ((p.y - self.origin.y) / RESOLUTION_M).round() as i64,
-        )
-    }
-
-    fn point(&self, (x, y): (i64, i64)) -> Point {
-        Point::new(
-            self.origin.x + x as f64 * RESOLUTION_M,
-            self.origin.y + y as f64 * RESOLUTION_M,
-        )
-    }
-
-    fn is_free(&self, (x, y): (i64, i64)) -> bool {
-        (0..self.width).contains(&x)
-            && (0..self.height).contains(&y)
-            && self.free[(y * self.width + x) as usize]
-    }
-}
 
 /// Length in metres of the shortest path from `start` to a point where `in_goal` holds, kept
 /// `clearance` from every rock's footprint (the start itself is allowed to be closer); `None`
@@ -93,32 +25,19 @@ pub fn shortest_path_m(
     clearance: f64,
     in_goal: impl Fn(Point) -> bool,
 ) -> Option<f64> {
-    let grid = Grid::new(world, start, clearance);
-    let from = grid.cell(start);
-    // Integer costs (micrometres) for the search; √2 rounded per diagonal move.
-    let straight = (RESOLUTION_M * 1e6).round() as u64;
-    let diagonal = (RESOLUTION_M * std::f64::consts::SQRT_2 * 1e6).round() as u64;
+    let (mut low, mut high) = (start, start);
+    for r in &world.rocks {
+        low = Point::new(low.x.min(r.position.x), low.y.min(r.position.y));
+        high = Point::new(high.x.max(r.position.x), high.y.max(r.position.y));
+    }
+    let border = Point::new(BORDER_M, BORDER_M);
+    let grid = Grid::over(world, low - border, high + border, clearance);
     let (_, cost) = dijkstra(
-        &from,
-        |&(x, y)| {
-            let grid = &grid;
-            [
-                (1, 0, straight),
-                (-1, 0, straight),
-                (0, 1, straight),
-                (0, -1, straight),
-                (1, 1, diagonal),
-                (1, -1, diagonal),
-                (-1, 1, diagonal),
-                (-1, -1, diagonal),
-            ]
-            .into_iter()
-            .map(move |(dx, dy, c)| ((x + dx, y + dy), c))
-            .filter(move |&(n, _)| grid.is_free(n))
-        },
+        &grid.cell(start),
+        |&c| grid.free_neighbours(c),
         |&c| in_goal(grid.point(c)),
     )?;
-    Some(cost as f64 * 1e-6)
+    Some(Grid::metres(cost))
 }
 
 #[cfg(test)]

@@ -47,9 +47,9 @@ pub enum NavigateCommand {
     /// Closed-loop trips through the rendered world of a synthetic dataset: at every step the
     /// stereo panorama is rendered at the rover's pose, detected, associated with the map of a
     /// `pipeline run` over that dataset, and the leg follower picks the heading; rocks are
-    /// obstacles (a hazard stop turns steps away from them). Writes trips.json, summary.json
-    /// and drive.png (000 Fig. 6 with the first three trips), e.g. `navigate drive --images
-    /// data/marsyard --run marsyard-run --trips 20`.
+    /// obstacles (a hazard avoidance drives each step around the rocks within 3 m). Writes
+    /// trips.json, summary.json and drive.png (000 Fig. 6 with the first three trips), e.g.
+    /// `navigate drive --images data/marsyard --run marsyard-run --trips 20`.
     Drive(super::drive::DriveArgs),
     /// Route directions (docs/DIRECTIONS.md) followed through panoramas rendered in a synthetic
     /// dataset's world: routes planned on the map of a `pipeline run` over it, each leg's

@@ -1,0 +1,315 @@
+//! The rover's local hazard avoidance in the closed loop (issue 15 item 3 allows "a simple
+//! documented local avoidance"), standing in for its hazard cameras. It sees the rocks within
+//! [`HAZARD_RANGE_M`] of the rover, never the map or the goal: the navigator gives a bearing
+//! from the panorama, and the avoidance only decides how to drive the next step that way.
+//!
+//! Each step, the first of these that ends clear of every rock's footprint by the clearance:
+//! 1. the rest of the detour of an earlier step 4, while the commanded bearing stays within
+//!    [`DETOUR_TURN_DEG`] of the one it was planned for;
+//! 2. the step on the commanded bearing;
+//! 3. that step turned by 20°, alternately either way, up to 100°;
+//! 4. a step along the shortest clear path ([`crate::clearance_grid`]) toward the point
+//!    [`HAZARD_RANGE_M`] ahead on the bearing, or, when that point cannot be reached, toward
+//!    the reachable point nearest to it. The step cuts straight to the farthest point of the
+//!    path in clear sight, then follows the path; the rest of the path is the detour.
+//!
+//! With none, the rover stays put for that step.
+//!
+//! Why in this order (`docs/NAVIGATION.md` has the closed loop's figures):
+//! - With steps 2 and 3 alone, a rover that drove into the pocket between two rocks a little
+//!   over its width apart stood there until its step budget ran out.
+//! - Without the detour's memory, the rover freed by step 4 went back into the pocket at the
+//!   next step, where the step on the bearing was clear again.
+//! - Paths taken before turns steered the rover around the rocks it was driving to: the rock a
+//!   step runs into is often the landmark of the leg. The closed loop lost more trips.
+
+use crate::clearance_grid::{Grid, RESOLUTION_M};
+use crate::world::World;
+use pathfinding::directed::dijkstra::{build_path, dijkstra_all};
+use qrm_core::geometry::Point;
+use qrm_core::measurement::angular_distance;
+
+/// How far around the rover the hazard cameras see rocks, metres.
+pub const HAZARD_RANGE_M: f64 = 3.0;
+/// Turns of a blocked step tried in order, degrees.
+const TURNS_DEG: [f64; 11] = [
+    0.0, 20.0, -20.0, 40.0, -40.0, 60.0, -60.0, 80.0, -80.0, 100.0, -100.0,
+];
+/// Widest change of the commanded bearing for which a detour is kept, degrees: the bearing to
+/// a landmark swings as the rover drives round a rock, a new leg's bearing jumps.
+const DETOUR_TURN_DEG: f64 = 60.0;
+/// Spacing of the points at which a straight segment's clearance is tested, metres.
+const SAMPLE_M: f64 = 0.05;
+
+/// The hazard avoidance of one trip: the detour it is following, if any (step 4 of the
+/// module), kept while the commanded bearing stays within [`DETOUR_TURN_DEG`] of the one it
+/// was planned for.
+#[derive(Clone, Debug, Default)]
+pub struct HazardAvoidance {
+    /// The rest of the detour's path, from the rover's position on.
+    detour: Vec<Point>,
+    /// The bearing it was planned for (world frame, radians).
+    azimuth: f64,
+}
+
+impl HazardAvoidance {
+    /// The end of one step of `length` metres from `from`, driven toward `azimuth` (world
+    /// frame, radians) and kept `clearance` from the footprints of the rocks within
+    /// [`HAZARD_RANGE_M`]. `None` when the rover has no clear way to move.
+    pub fn drive(
+        &mut self,
+        world: &World,
+        from: Point,
+        azimuth: f64,
+        length: f64,
+        clearance: f64,
+    ) -> Option<Point> {
+        // The footprints within sight, grown by the clearance.
+        let near: Vec<(Point, f64)> = world
+            .rocks
+            .iter()
+            .map(|r| (r.position, world.contact_radius(r.id) + clearance))
+            .filter(|&(p, grown)| p.distance(from) < HAZARD_RANGE_M + grown)
+            .collect();
+        let toward = |a: f64, d: f64| Point::new(from.x + d * a.cos(), from.y + d * a.sin());
+        let detour = std::mem::take(&mut self.detour);
+        if !detour.is_empty()
+            && angular_distance(azimuth, self.azimuth) < DETOUR_TURN_DEG.to_radians()
+        {
+            let way: Vec<Point> = std::iter::once(from).chain(detour).collect();
+            let (next, rest) = along(&way, length);
+            if outside(&near, next) {
+                self.detour = rest;
+                return Some(next);
+            }
+        }
+        if let Some(next) = TURNS_DEG
+            .iter()
+            .map(|t| toward(azimuth + t.to_radians(), length))
+            .find(|&p| outside(&near, p))
+        {
+            return Some(next);
+        }
+        let way = around(
+            world,
+            &near,
+            from,
+            toward(azimuth, HAZARD_RANGE_M),
+            clearance,
+        )?;
+        let (next, rest) = along(&way, length);
+        self.detour = rest;
+        self.azimuth = azimuth;
+        Some(next)
+    }
+}
+
+/// The shortest clear path from `from` toward `subgoal` (see the module's step 4), starting at
+/// `from`; `near` are the footprints within sight, grown by `clearance`. `None` when the rover
+/// is as near to the subgoal as it can get.
+fn around(
+    world: &World,
+    near: &[(Point, f64)],
+    from: Point,
+    subgoal: Point,
+    clearance: f64,
+) -> Option<Vec<Point>> {
+    let reach = Point::new(HAZARD_RANGE_M + 1.0, HAZARD_RANGE_M + 1.0);
+    let grid = Grid::over(world, from - reach, from + reach, clearance);
+    let start = grid.cell(from);
+    let reached = dijkstra_all(&start, |&c| grid.free_neighbours(c));
+    // The subgoal if the rover can get there, else as near to it as it can get; the shorter
+    // way among equals.
+    let (end, _) = reached
+        .iter()
+        .map(|(&c, &(_, cost))| (c, cost))
+        .chain(std::iter::once((start, 0)))
+        .min_by_key(|&(c, cost)| (Grid::micrometres(grid.point(c).distance(subgoal)), cost, c))?;
+    if end == start {
+        return None;
+    }
+    let path: Vec<Point> = build_path(&end, &reached)
+        .into_iter()
+        .map(|c| grid.point(c))
+        .collect();
+    // Cut straight to the farthest point of the path in clear sight, then follow the path.
+    let cut = (1..path.len())
+        .rev()
+        .find(|&k| straight_and_clear(near, from, path[k]))
+        .unwrap_or(1);
+    Some(
+        std::iter::once(from)
+            .chain(path[cut..].iter().copied())
+            .collect(),
+    )
+}
+
+/// The point `length` metres along the polyline `way` (or its end, if it is shorter), and the
+/// rest of the polyline beyond it.
+fn along(way: &[Point], length: f64) -> (Point, Vec<Point>) {
+    let mut left = length;
+    for (k, leg) in way.windows(2).enumerate() {
+        let span = leg[0].distance(leg[1]);
+        if span >= left && span > 0.0 {
+            let t = left / span;
+            let at = Point::new(
+                leg[0].x + t * (leg[1].x - leg[0].x),
+                leg[0].y + t * (leg[1].y - leg[0].y),
+            );
+            return (at, way[k + 1..].to_vec());
+        }
+        left -= span;
+    }
+    (way[way.len() - 1], Vec::new())
+}
+
+/// Whether the segment from `from` to `to` stays outside every grown footprint of `near`
+/// (centre, radius), except within a grid cell of `from`: a rover that starts closer than the
+/// clearance may still drive away.
+fn straight_and_clear(near: &[(Point, f64)], from: Point, to: Point) -> bool {
+    let span = from.distance(to);
+    let n = (span / SAMPLE_M).ceil().max(1.0) as usize;
+    (0..=n)
+        .map(|k| k as f64 / n as f64)
+        .filter(|t| t * span > 1.5 * RESOLUTION_M)
+        .all(|t| {
+            let p = Point::new(from.x + t * (to.x - from.x), from.y + t * (to.y - from.y));
+            outside(near, p)
+        })
+}
+
+/// Whether `p` lies outside every grown footprint of `near` (centre, radius).
+fn outside(near: &[(Point, f64)], p: Point) -> bool {
+    near.iter()
+        .all(|&(centre, grown)| centre.distance(p) >= grown)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CLEARANCE: f64 = 0.3;
+
+    fn clear_of(world: &World, p: Point) -> bool {
+        world
+            .rocks
+            .iter()
+            .all(|r| r.position.distance(p) >= world.contact_radius(r.id) + CLEARANCE)
+    }
+
+    #[test]
+    fn with_nothing_in_the_way_the_step_is_the_commanded_one() {
+        let world = World::generate(1, &[(Point::new(0.0, 9.0), 0.5)]);
+        let azimuth = 0.3f64;
+        let next = HazardAvoidance::default()
+            .drive(&world, Point::new(0.0, 0.0), azimuth, 0.5, CLEARANCE)
+            .unwrap();
+        let straight = Point::new(0.5 * azimuth.cos(), 0.5 * azimuth.sin());
+        assert!(next.distance(straight) < 1e-9, "{next:?}");
+    }
+
+    #[test]
+    fn a_rock_ahead_is_driven_around_and_passed() {
+        let world = World::generate(2, &[(Point::new(2.0, 0.0), 0.6)]);
+        let mut avoidance = HazardAvoidance::default();
+        let mut at = Point::new(0.0, 0.0);
+        for _ in 0..20 {
+            let next = avoidance
+                .drive(&world, at, 0.0, 0.5, CLEARANCE)
+                .expect("a way around");
+            assert!(clear_of(&world, next), "{next:?}");
+            // A step bends with the path: never longer than commanded.
+            let span = at.distance(next);
+            assert!(span <= 0.5 + 1e-9 && span > 0.25, "{span}");
+            at = next;
+        }
+        assert!(at.x > 4.0, "the rover passed the rock: {at:?}");
+    }
+
+    #[test]
+    fn the_pocket_between_two_close_rocks_is_left_the_way_round() {
+        // Two rocks whose clearance discs overlap across the commanded bearing, and the rover
+        // drives straight at the gap: turning the step alone left the rover standing there.
+        let world = World::generate(
+            3,
+            &[(Point::new(2.0, -0.6), 0.45), (Point::new(2.0, 0.6), 0.45)],
+        );
+        let gap = world.rocks[1].position.distance(world.rocks[0].position)
+            - world.contact_radius(0)
+            - world.contact_radius(1);
+        assert!(gap < 2.0 * CLEARANCE, "the rocks must close the gap: {gap}");
+        let mut avoidance = HazardAvoidance::default();
+        let mut at = Point::new(0.8, 0.0);
+        for _ in 0..30 {
+            let Some(next) = avoidance.drive(&world, at, 0.0, 0.5, CLEARANCE) else {
+                panic!("stuck at {at:?}");
+            };
+            assert!(clear_of(&world, next), "{next:?}");
+            at = next;
+        }
+        assert!(at.x > 3.5, "the rover went round both rocks: {at:?}");
+    }
+
+    #[test]
+    fn a_detour_out_of_a_dead_end_is_followed_to_its_end() {
+        // A U of rocks open toward the rover, which stands at its bottom and is sent on into
+        // it: every turn is blocked there, and once out of the dead end the step on the
+        // bearing is clear again and leads back in.
+        let mut u: Vec<(Point, f64)> = (0..5)
+            .map(|k| (Point::new(2.6, -1.0 + 0.5 * k as f64), 0.5))
+            .collect();
+        for k in 0..4 {
+            let x = 0.6 + 0.5 * k as f64;
+            u.push((Point::new(x, -1.0), 0.5));
+            u.push((Point::new(x, 1.0), 0.5));
+        }
+        let world = World::generate(5, &u);
+        let mut avoidance = HazardAvoidance::default();
+        let mut at = Point::new(1.5, 0.0);
+        assert!(clear_of(&world, at));
+        let boxed_in = TURNS_DEG.iter().all(|t| {
+            let a = t.to_radians();
+            !clear_of(
+                &world,
+                Point::new(at.x + 0.5 * a.cos(), at.y + 0.5 * a.sin()),
+            )
+        });
+        assert!(boxed_in, "every turn must be blocked at the bottom");
+        for _ in 0..40 {
+            if let Some(next) = avoidance.drive(&world, at, 0.0, 0.5, CLEARANCE) {
+                assert!(clear_of(&world, next), "{next:?}");
+                at = next;
+            }
+        }
+        assert!(at.x > 3.6, "the rover left the dead end behind: {at:?}");
+    }
+
+    #[test]
+    fn a_rover_hemmed_in_comes_as_near_as_it_can_and_stays_put() {
+        let ring: Vec<(Point, f64)> = (0..10)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / 10.0;
+                (Point::new(1.0 * a.cos(), 1.0 * a.sin()), 0.6)
+            })
+            .collect();
+        let world = World::generate(4, &ring);
+        for k in 0..10 {
+            let (a, b) = (&world.rocks[k], &world.rocks[(k + 1) % 10]);
+            let gap = a.position.distance(b.position)
+                - world.contact_radius(a.id)
+                - world.contact_radius(b.id);
+            assert!(gap < 2.0 * CLEARANCE, "the ring must be closed: {gap}");
+        }
+        let centre = Point::new(0.0, 0.0);
+        let mut at = centre;
+        let mut steps = 0;
+        let mut avoidance = HazardAvoidance::default();
+        while let Some(next) = avoidance.drive(&world, at, 0.0, 0.5, CLEARANCE) {
+            assert!(clear_of(&world, next), "{next:?}");
+            at = next;
+            steps += 1;
+            assert!(steps < 5, "the rover keeps moving: {at:?}");
+        }
+        assert!(at.distance(centre) < 0.5, "{at:?}");
+    }
+}
