@@ -103,7 +103,7 @@ pub struct Trip {
     pub path: Vec<[f64; 2]>,
     /// Steps whose segment crossed a rock's footprint.
     pub collisions: usize,
-    /// Steps the hazard avoidance turned or held.
+    /// Steps on which the hazard avoidance left the commanded bearing or held the rover.
     pub avoided: usize,
     /// Seconds of navigator compute per step: detection to heading, rendering excluded.
     pub navigator_seconds: Vec<f64>,
@@ -145,7 +145,7 @@ pub struct StepLog {
     pub bearing_deg: Option<f64>,
     /// Re-plans so far.
     pub replans: usize,
-    /// The hazard avoidance turned or held this step.
+    /// The hazard avoidance left the commanded bearing or held the rover this step.
     pub avoided: bool,
     /// Navigator compute of this step, seconds (detection to heading), and of it the
     /// detection in the stereo pair.

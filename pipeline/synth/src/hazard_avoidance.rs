@@ -1,7 +1,7 @@
 //! The rover's local hazard avoidance in the closed loop (issue 15 item 3 allows "a simple
 //! documented local avoidance"), standing in for its hazard cameras. It sees the rocks within
-//! [`HAZARD_RANGE_M`] of the rover, never the map or the goal: the navigator gives a bearing
-//! from the panorama, and the avoidance only decides how to drive the next step that way.
+//! [`SIGHT_M`] of the rover, never the map or the goal: the navigator gives a bearing from the
+//! panorama, and the avoidance only decides how to drive the next step that way.
 //!
 //! Each step, the first of these that ends clear of every rock's footprint by the clearance:
 //! 1. the rest of the detour of an earlier step 4, while the commanded bearing stays within
@@ -9,7 +9,7 @@
 //! 2. the step on the commanded bearing;
 //! 3. that step turned by 20°, alternately either way, up to 100°;
 //! 4. a step along the shortest clear path ([`crate::clearance_grid`]) toward the point
-//!    [`HAZARD_RANGE_M`] ahead on the bearing, or, when that point cannot be reached, toward
+//!    [`LOOKAHEAD_M`] ahead on the bearing, or, when that point cannot be reached, toward
 //!    the reachable point nearest to it. The step cuts straight to the farthest point of the
 //!    path in clear sight, then follows the path; the rest of the path is the detour.
 //!
@@ -29,8 +29,11 @@ use pathfinding::directed::dijkstra::{build_path, dijkstra_all};
 use qrm_core::geometry::Point;
 use qrm_core::measurement::angular_distance;
 
-/// How far around the rover the hazard cameras see rocks, metres.
-pub const HAZARD_RANGE_M: f64 = 3.0;
+/// How far ahead on the bearing a detour aims, metres.
+const LOOKAHEAD_M: f64 = 3.0;
+/// Half the side of the square around the rover in which the hazard cameras see rocks, metres:
+/// beyond the lookahead, so that a path has room to go round a rock standing on it.
+const SIGHT_M: f64 = 4.0;
 /// Turns of a blocked step tried in order, degrees.
 const TURNS_DEG: [f64; 11] = [
     0.0, 20.0, -20.0, 40.0, -40.0, 60.0, -60.0, 80.0, -80.0, 100.0, -100.0,
@@ -55,7 +58,7 @@ pub struct HazardAvoidance {
 impl HazardAvoidance {
     /// The end of one step of `length` metres from `from`, driven toward `azimuth` (world
     /// frame, radians) and kept `clearance` from the footprints of the rocks within
-    /// [`HAZARD_RANGE_M`]. `None` when the rover has no clear way to move.
+    /// [`SIGHT_M`]. `None` when the rover has no clear way to move.
     pub fn drive(
         &mut self,
         world: &World,
@@ -64,12 +67,12 @@ impl HazardAvoidance {
         length: f64,
         clearance: f64,
     ) -> Option<Point> {
-        // The footprints within sight, grown by the clearance.
+        // The footprints that reach into sight, grown by the clearance.
         let near: Vec<(Point, f64)> = world
             .rocks
             .iter()
             .map(|r| (r.position, world.contact_radius(r.id) + clearance))
-            .filter(|&(p, grown)| p.distance(from) < HAZARD_RANGE_M + grown)
+            .filter(|&(p, grown)| p.distance(from) < SIGHT_M * std::f64::consts::SQRT_2 + grown)
             .collect();
         let toward = |a: f64, d: f64| Point::new(from.x + d * a.cos(), from.y + d * a.sin());
         let detour = std::mem::take(&mut self.detour);
@@ -90,13 +93,7 @@ impl HazardAvoidance {
         {
             return Some(next);
         }
-        let way = around(
-            world,
-            &near,
-            from,
-            toward(azimuth, HAZARD_RANGE_M),
-            clearance,
-        )?;
+        let way = around(world, &near, from, toward(azimuth, LOOKAHEAD_M), clearance)?;
         let (next, rest) = along(&way, length);
         self.detour = rest;
         self.azimuth = azimuth;
@@ -114,8 +111,8 @@ fn around(
     subgoal: Point,
     clearance: f64,
 ) -> Option<Vec<Point>> {
-    let reach = Point::new(HAZARD_RANGE_M + 1.0, HAZARD_RANGE_M + 1.0);
-    let grid = Grid::over(world, from - reach, from + reach, clearance);
+    let sight = Point::new(SIGHT_M, SIGHT_M);
+    let grid = Grid::over(world, from - sight, from + sight, clearance);
     let start = grid.cell(from);
     let reached = dijkstra_all(&start, |&c| grid.free_neighbours(c));
     // The subgoal if the rover can get there, else as near to it as it can get; the shorter

@@ -47,7 +47,7 @@ pub enum NavigateCommand {
     /// Closed-loop trips through the rendered world of a synthetic dataset: at every step the
     /// stereo panorama is rendered at the rover's pose, detected, associated with the map of a
     /// `pipeline run` over that dataset, and the leg follower picks the heading; rocks are
-    /// obstacles (a hazard avoidance drives each step around the rocks within 3 m). Writes
+    /// obstacles (a hazard avoidance drives each step around the rocks within 4 m). Writes
     /// trips.json, summary.json and drive.png (000 Fig. 6 with the first three trips), e.g.
     /// `navigate drive --images data/marsyard --run marsyard-run --trips 20`.
     Drive(super::drive::DriveArgs),
