@@ -15,6 +15,15 @@ const MICROMETRES: f64 = 1e6;
 /// A grid cell, by column and row.
 pub type Cell = (i64, i64);
 
+/// Every rock's footprint grown by `clearance`, as discs (centre, radius): where the rover's
+/// centre may not be (`World::contact_radius`).
+pub fn grown_footprints(world: &World, clearance: f64) -> impl Iterator<Item = (Point, f64)> + '_ {
+    world
+        .rocks
+        .iter()
+        .map(move |r| (r.position, world.contact_radius(r.id) + clearance))
+}
+
 /// Which grid points keep the clearance from every rock.
 pub struct Grid {
     origin: Point,
@@ -24,17 +33,17 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// The grid over the rectangle from `low` to `high`; a point is free when it lies at least
-    /// `clearance` from every rock's footprint (`World::contact_radius`).
-    pub fn over(world: &World, low: Point, high: Point, clearance: f64) -> Grid {
+    /// The grid over the rectangle from `low` to `high`; a point is free when it lies outside
+    /// every disc of `discs` (centre, radius: footprints grown by the clearance,
+    /// [`grown_footprints`]).
+    pub fn over(discs: &[(Point, f64)], low: Point, high: Point) -> Grid {
         let width = ((high.x - low.x) / RESOLUTION_M).ceil() as i64 + 1;
         let height = ((high.y - low.y) / RESOLUTION_M).ceil() as i64 + 1;
         let mut free = vec![true; (width * height) as usize];
-        for r in &world.rocks {
-            let reach = world.contact_radius(r.id) + clearance;
+        for &(centre, reach) in discs {
             let (cx, cy) = (
-                (r.position.x - low.x) / RESOLUTION_M,
-                (r.position.y - low.y) / RESOLUTION_M,
+                (centre.x - low.x) / RESOLUTION_M,
+                (centre.y - low.y) / RESOLUTION_M,
             );
             let cells = (reach / RESOLUTION_M).ceil() as i64 + 1;
             for y in (cy as i64 - cells).max(0)..=(cy as i64 + cells).min(height - 1) {
@@ -43,7 +52,7 @@ impl Grid {
                         low.x + x as f64 * RESOLUTION_M,
                         low.y + y as f64 * RESOLUTION_M,
                     );
-                    if p.distance(r.position) < reach {
+                    if p.distance(centre) < reach {
                         free[(y * width + x) as usize] = false;
                     }
                 }

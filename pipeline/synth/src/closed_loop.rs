@@ -32,6 +32,7 @@
 //! judged against the truth only after the trip: the rover stopped in the goal landmark's
 //! Voronoi cell (the landmark whose rock is nearest to it).
 
+use crate::clearance_grid::grown_footprints;
 use crate::hazard_avoidance::HazardAvoidance;
 use crate::reference_path::shortest_path_m;
 use crate::render::{render, Eye, Pose};
@@ -173,10 +174,7 @@ impl Terrain<'_> {
 
     /// Whether `p` lies within `margin` of a rock's footprint.
     pub(crate) fn blocked(&self, p: Point, margin: f64) -> bool {
-        self.world
-            .rocks
-            .iter()
-            .any(|r| r.position.distance(p) < self.world.contact_radius(r.id) + margin)
+        grown_footprints(self.world, margin).any(|(centre, grown)| centre.distance(p) < grown)
     }
 
     /// Whether the segment `a`–`b` crosses a rock's footprint (sampled every 5 cm).

@@ -23,7 +23,7 @@
 //! - Paths taken before turns steered the rover around the rocks it was driving to: the rock a
 //!   step runs into is often the landmark of the leg. The closed loop lost more trips.
 
-use crate::clearance_grid::{Grid, RESOLUTION_M};
+use crate::clearance_grid::{grown_footprints, Grid, RESOLUTION_M};
 use crate::world::World;
 use pathfinding::directed::dijkstra::{build_path, dijkstra_all};
 use qrm_core::geometry::Point;
@@ -68,10 +68,7 @@ impl HazardAvoidance {
         clearance: f64,
     ) -> Option<Point> {
         // The footprints that reach into sight, grown by the clearance.
-        let near: Vec<(Point, f64)> = world
-            .rocks
-            .iter()
-            .map(|r| (r.position, world.contact_radius(r.id) + clearance))
+        let near: Vec<(Point, f64)> = grown_footprints(world, clearance)
             .filter(|&(p, grown)| p.distance(from) < SIGHT_M * std::f64::consts::SQRT_2 + grown)
             .collect();
         let toward = |a: f64, d: f64| Point::new(from.x + d * a.cos(), from.y + d * a.sin());
@@ -93,7 +90,7 @@ impl HazardAvoidance {
         {
             return Some(next);
         }
-        let way = around(world, &near, from, toward(azimuth, LOOKAHEAD_M), clearance)?;
+        let way = around(&near, from, toward(azimuth, LOOKAHEAD_M))?;
         let (next, rest) = along(&way, length);
         self.detour = rest;
         self.azimuth = azimuth;
@@ -102,17 +99,11 @@ impl HazardAvoidance {
 }
 
 /// The shortest clear path from `from` toward `subgoal` (see the module's step 4), starting at
-/// `from`; `near` are the footprints within sight, grown by `clearance`. `None` when the rover
-/// is as near to the subgoal as it can get.
-fn around(
-    world: &World,
-    near: &[(Point, f64)],
-    from: Point,
-    subgoal: Point,
-    clearance: f64,
-) -> Option<Vec<Point>> {
+/// `from`; `near` are the grown footprints that reach into sight. `None` when the rover is as
+/// near to the subgoal as it can get.
+fn around(near: &[(Point, f64)], from: Point, subgoal: Point) -> Option<Vec<Point>> {
     let sight = Point::new(SIGHT_M, SIGHT_M);
-    let grid = Grid::over(world, from - sight, from + sight, clearance);
+    let grid = Grid::over(near, from - sight, from + sight);
     let start = grid.cell(from);
     let reached = dijkstra_all(&start, |&c| grid.free_neighbours(c));
     // The subgoal if the rover can get there, else as near to it as it can get; the shorter

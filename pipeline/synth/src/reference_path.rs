@@ -8,7 +8,7 @@
 //! may graze a clearance disc), the start is rounded to the grid, and a gap narrower than a
 //! cell may close. The reference is the true shortest path to within those approximations.
 
-use crate::clearance_grid::Grid;
+use crate::clearance_grid::{grown_footprints, Grid};
 use crate::world::World;
 use pathfinding::directed::dijkstra::dijkstra;
 use qrm_core::geometry::Point;
@@ -31,7 +31,8 @@ pub fn shortest_path_m(
         high = Point::new(high.x.max(r.position.x), high.y.max(r.position.y));
     }
     let border = Point::new(BORDER_M, BORDER_M);
-    let grid = Grid::over(world, low - border, high + border, clearance);
+    let discs: Vec<(Point, f64)> = grown_footprints(world, clearance).collect();
+    let grid = Grid::over(&discs, low - border, high + border);
     let (_, cost) = dijkstra(
         &grid.cell(start),
         |&c| grid.free_neighbours(c),

@@ -249,10 +249,10 @@ impl Labelled {
         rb.scale(self.cos_bc) - ra.scale(self.cos_ac)
     }
 
-    /// Enclosure of boundary function `f` (see [`Labelled::enclosures`]), written in the ranges and the
-    /// cosines and sines of the turns between bearings, and grouped so that each range multiplies
-    /// what it scales: expanded as differences of squared distances, a far landmark's range
-    /// interval enters twice and its width swamps a value orders of magnitude smaller.
+    /// Enclosure of boundary function `f` (see [`Labelled::enclosures`]), written in the ranges
+    /// and the cosines and sines of the turns between bearings, and grouped so that each range
+    /// multiplies what it scales: expanded as differences of squared distances, a far landmark's
+    /// range interval enters twice and its width swamps a value orders of magnitude smaller.
     fn boundary(&self, f: usize) -> Interval {
         let [ra, rb, rc] = self.r;
         match f {
