@@ -90,6 +90,7 @@ impl<C: Calculus> KnownMap<C> {
             .map(|record| Frame {
                 accumulated: false,
                 departed: Vec::new(),
+                unmapped: Vec::new(),
                 landmarks: record
                     .detections
                     .iter()

@@ -76,6 +76,7 @@ mod tests {
         Frame {
             accumulated: false,
             departed: Vec::new(),
+            unmapped: Vec::new(),
             landmarks: points
                 .iter()
                 .map(|&(l, point)| (l, Placed::disc(point, 0.3)))

@@ -10,9 +10,11 @@
 //!    registration of the fewest pairs that puts several of the frame's other landmarks in
 //!    view where the station saw nothing is a chance fit and is dropped, and so is one that
 //!    holds no landmark the rover saw lately ([`LastSeen`]: a loop closure on looks alone). A
-//!    detection placed looser than 2 m pairs with nothing, and a pair whose landmark lies in
+//!    detection placed looser than 4 m pairs with nothing, and a pair whose landmark lies in
 //!    the direction of a detection mapping does not use is dropped (it may be that rock). An
-//!    anchor must be paired so by most registered frames that hold its landmark, and anchors
+//!    anchor must be paired so by most registered frames that hold its landmark; one placed
+//!    looser than 2 m (a far rock) by every one, two at least, where none knows another rock
+//!    it may be ([`Registration::crowded`]). Anchors
 //!    are checked against each other: a triple of anchors whose measured states do not
 //!    overlap the map's is inconsistent, and the anchor in most such triples is dropped until
 //!    none is left. Matches are then checked against earlier stations' placements of their
@@ -49,7 +51,7 @@ pub use gallery::{distance, AppearanceScales, Gallery, Profile};
 pub use placement::Placed;
 pub use recency::LastSeen;
 pub use registration::{displacement, register, Frame, Registration};
-use registration::{MIN_INLIERS, SIGNIFICANT_NFA};
+use registration::{ANCHOR_RADIUS_M, MIN_INLIERS, SIGNIFICANT_NFA};
 pub use sketch::Sketch;
 
 use crate::detection::Appearance;
@@ -165,6 +167,9 @@ pub struct StationEvidence {
     /// The rays of the station's other detections, those mapping does not use (touching,
     /// doubtful): a landmark seen in one of their directions may be that rock.
     pub unused: Vec<Ray>,
+    /// The placements of those other detections whose range bounds one: rocks this station
+    /// maps no landmark for ([`Frame::unmapped`]).
+    pub unused_placed: Vec<Placed>,
 }
 
 /// The association decision for one detection.
@@ -425,10 +430,12 @@ fn anchors(
         |&(i, l): &(usize, LandmarkId)| pairs.iter().any(|&(j, m)| (j == i) != (m == l));
     // Frames that hold a landmark but pair it with no detection, or another, doubt the pair.
     let agreed = |&(i, l): &(usize, LandmarkId)| {
-        let support = registrations
-            .iter()
-            .filter(|(_, r)| r.pairs.contains(&(i, l)))
-            .count();
+        let supporting = || {
+            registrations
+                .iter()
+                .filter(|(_, r)| r.pairs.contains(&(i, l)))
+        };
+        let support = supporting().count();
         let holding = registrations
             .iter()
             // The sketch holds more look-alikes near each landmark than one station sees, so
@@ -447,7 +454,10 @@ fn anchors(
                     })
             })
             .count();
-        2 * support > holding && support >= min_support
+        let short = placed[i].is_none_or(|p| p.reach() <= ANCHOR_RADIUS_M);
+        2 * support > holding
+            && support >= min_support
+            && (short || long_anchor(&supporting().collect::<Vec<_>>(), holding, placed[i], l))
     };
     pairs
         .iter()
@@ -500,6 +510,28 @@ fn placed_near(
                 .collect()
         })
         .collect()
+}
+
+/// Whether a pair of a detection placed looser than [`ANCHOR_RADIUS_M`] (a far rock) with
+/// landmark `l` anchors: every registered frame holding `l` makes it (`holding`), two or more
+/// do, one a station's frame (the sketch's averaged positions alone re-identified a far rock's
+/// neighbour: JPEG marsyard seed 3, station 40), and none knows another rock where the pair's
+/// placement lies ([`Registration::crowded`]). Far rocks are held back otherwise, and where
+/// they stand apart (sparse fields) the map loses most of them; where they cluster, a far
+/// placement reaches several.
+fn long_anchor(
+    supporting: &[&(&Frame, Registration)],
+    holding: usize,
+    placed: Option<Placed>,
+    l: LandmarkId,
+) -> bool {
+    let Some(p) = placed else {
+        return false;
+    };
+    supporting.len() == holding
+        && supporting.len() >= 2
+        && supporting.iter().any(|(frame, _)| !frame.accumulated)
+        && supporting.iter().all(|(frame, r)| !r.crowded(frame, &p, l))
 }
 
 /// Re-tests one held-back detection of an earlier station against the current map (000 §VI-C
@@ -755,6 +787,7 @@ mod tests {
                 detections,
                 colour: true,
                 unused: Vec::new(),
+                unused_placed: Vec::new(),
             },
         )
     }
@@ -806,6 +839,7 @@ mod tests {
         Frame {
             accumulated: false,
             departed: Vec::new(),
+            unmapped: Vec::new(),
             landmarks: points
                 .iter()
                 .enumerate()
@@ -830,6 +864,7 @@ mod tests {
                 (3, at([4.0, -16.0])),
                 (4, at([40.0, 30.0])),
             ],
+            unmapped: Vec::new(),
         };
         let registration = Registration {
             pairs: Vec::new(),
@@ -952,6 +987,7 @@ mod tests {
             accumulated: true,
             landmarks: vec![(0, at(q))],
             departed: Vec::new(),
+            unmapped: Vec::new(),
         };
         let by_sketch = Registration {
             pairs: Vec::new(),
@@ -970,6 +1006,37 @@ mod tests {
         let far = sketch([20.0, 10.0]);
         let registrations = [(&station_frame, by_frame), (&far, by_sketch)];
         assert!(anchors(&registrations, &candidates, &placed, 1).is_empty());
+    }
+
+    /// A far rock's detection, placed 3 m deep along its bearing, anchors to the landmark two
+    /// station frames pair it with, unless one of them knows another rock within its reach:
+    /// another landmark, or a rock it saw and did not map.
+    #[test]
+    fn a_far_rock_anchors_where_two_station_frames_know_no_other_rock_it_may_be() {
+        let placed = [Some(Placed::along([10.0, 0.0], 0.0, 3.0, 0.1))];
+        let candidates = vec![vec![(0, 0.1)]];
+        let pairing = Registration {
+            pairs: vec![(0, 0)],
+            motion: [1.0, 0.0, 0.0, 0.0],
+            nfa: 0.0,
+        };
+        let landmark = frame(&[[10.0, 0.0]]);
+        let anchored = |second: &Frame| {
+            let registrations = [(&landmark, pairing.clone()), (second, pairing.clone())];
+            !anchors(&registrations, &candidates, &placed, 1).is_empty()
+        };
+        assert!(anchored(&landmark));
+        assert!(anchors(&[(&landmark, pairing.clone())], &candidates, &placed, 1).is_empty());
+        assert!(!anchored(&frame(&[[10.0, 0.0], [12.0, 0.0]])));
+        let unmapped = |point: [f64; 2]| Frame {
+            unmapped: vec![at(point)],
+            ..frame(&[[10.0, 0.0]])
+        };
+        assert!(!anchored(&unmapped([12.0, 0.0])));
+        assert!(anchored(&unmapped([15.0, 0.0])));
+        // A detection placed within 2 m anchors on one frame's pairing.
+        let near = [Some(Placed::along([10.0, 0.0], 0.0, 1.5, 0.1))];
+        assert!(!anchors(&[(&landmark, pairing)], &candidates, &near, 1).is_empty());
     }
 
     #[test]

@@ -13,7 +13,8 @@
 //! qualitative and is never fed a metric position. Landmarks not seen for [`WINDOW`] stations
 //! leave the registration, so its drift over a long traverse never reaches it; they stay
 //! where the sketch last put them (`Frame::departed`) until the sketch starts again, to rule
-//! out look-alikes far from there.
+//! out look-alikes far from there. The rocks the last few stations saw and did not map are
+//! kept too (`Frame::unmapped`): a far rock's placement may reach one of them.
 
 use super::registration::{misfit, Frame, Motion};
 use super::Placed;
@@ -34,6 +35,10 @@ const MIN_RADIUS_M: f64 = 0.25;
 
 /// Fewest shared landmarks that fix a station's motion into the sketch.
 const MIN_SHARED: usize = 3;
+
+/// Stations an unmapped rock's placement stays in the sketch: each is one station's
+/// placement, not averaged, and only as right as that station's motion into the sketch.
+const UNMAPPED_WINDOW: usize = 5;
 
 /// A landmark's position in the sketch.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,6 +61,8 @@ pub struct Sketch {
     departed: Vec<Sketched>,
     /// The last station whose sightings entered the sketch.
     updated: Option<usize>,
+    /// Rocks recent stations saw that no landmark holds, by the station that saw them.
+    unmapped: Vec<(usize, Placed)>,
 }
 
 impl Sketch {
@@ -77,6 +84,12 @@ impl Sketch {
                 .filter(|s| station > s.seen + WINDOW)
                 .map(|s| (s.landmark, s.placed))
                 .collect(),
+            unmapped: self
+                .unmapped
+                .iter()
+                .filter(|(seen, _)| station <= seen + UNMAPPED_WINDOW)
+                .map(|(_, placed)| *placed)
+                .collect(),
         }
     }
 
@@ -86,19 +99,26 @@ impl Sketch {
         self.departed.retain(|s| s.landmark != landmark);
     }
 
-    /// Brings station `station`'s fused sightings (placed around it) into the sketch: the
+    /// Brings station `station`'s fused sightings (placed around it) into the sketch, with the
+    /// rocks it saw that no landmark holds (`unmapped`): the
     /// rigid motion that its landmarks already in the sketch fit moves them there (pairs
     /// that do not fit it are left out of the fit; a placement away from its landmark's
     /// estimate is left out of the update). A station sharing
     /// too few landmarks with the sketch starts a new sketch in its own coordinates once the
     /// old one has not been updated for [`WINDOW`] stations (the rover has lost it); until
     /// then it is left out. Returns whether the sighting entered the sketch.
-    pub fn update(&mut self, station: usize, sightings: &[(LandmarkId, Placed)]) -> bool {
+    pub fn update(
+        &mut self,
+        station: usize,
+        sightings: &[(LandmarkId, Placed)],
+        unmapped: &[Placed],
+    ) -> bool {
         let motion = match self.motion(sightings) {
             Some(motion) => motion,
             None if self.updated.is_none_or(|u| station > u + WINDOW) => {
                 self.landmarks.clear();
                 self.departed.clear();
+                self.unmapped.clear();
                 Motion::identity()
             }
             None => return false,
@@ -107,6 +127,13 @@ impl Sketch {
             let placed = motion.apply_placed(&p).at_least(MIN_RADIUS_M);
             self.merge(landmark, placed, station);
         }
+        self.unmapped
+            .retain(|(seen, _)| station <= seen + UNMAPPED_WINDOW);
+        self.unmapped.extend(
+            unmapped
+                .iter()
+                .map(|p| (station, motion.apply_placed(p).at_least(MIN_RADIUS_M))),
+        );
         let (kept, departed): (Vec<Sketched>, Vec<Sketched>) = std::mem::take(&mut self.landmarks)
             .into_iter()
             .partition(|s| station <= s.seen + WINDOW);
@@ -203,9 +230,9 @@ mod tests {
     #[test]
     fn landmarks_seen_from_a_moved_station_join_the_first_stations_coordinates() {
         let mut sketch = Sketch::default();
-        assert!(sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3])));
+        assert!(sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]), &[]));
         // The next station sees three of them and two new ones, turned and shifted.
-        assert!(sketch.update(1, &seen(1.1, [2.0, -3.0], &[1, 2, 3, 4, 5])));
+        assert!(sketch.update(1, &seen(1.1, [2.0, -3.0], &[1, 2, 3, 4, 5]), &[]));
         for (k, rock) in FIELD.iter().enumerate() {
             let p = position(&sketch, 1, k as LandmarkId).expect("in the sketch");
             let gap = distance(p, *rock);
@@ -217,11 +244,11 @@ mod tests {
     #[test]
     fn a_sighting_that_does_not_fit_the_motion_is_left_out() {
         let mut sketch = Sketch::default();
-        sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3, 4]));
+        sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3, 4]), &[]);
         // A wrong association: the station calls rock 5 landmark 0.
         let mut sightings = seen(0.4, [1.0, 1.0], &[1, 2, 3, 4, 5]);
         sightings[4].0 = 0;
-        assert!(sketch.update(1, &sightings));
+        assert!(sketch.update(1, &sightings, &[]));
         let p = position(&sketch, 1, 0).expect("in the sketch");
         assert!(distance(p, FIELD[0]) < 1e-9, "{p:?}");
         for k in 1..5 {
@@ -233,10 +260,10 @@ mod tests {
     #[test]
     fn placements_are_averaged_and_tighten() {
         let mut sketch = Sketch::default();
-        sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]));
+        sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]), &[]);
         let mut nudged = seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]);
         nudged[0].1.point[0] += 0.2;
-        sketch.update(1, &nudged);
+        sketch.update(1, &nudged, &[]);
         let p = position(&sketch, 1, 0).expect("in the sketch");
         // Between the two placements (the fit spreads the nudge over the four pairs).
         assert!(p[0] > FIELD[0][0] && p[0] < FIELD[0][0] + 0.2, "{p:?}");
@@ -264,8 +291,8 @@ mod tests {
         };
         let mut sketch = Sketch::default();
         // Both placements 1.5 m off along their bearings, from the origin and from (8, 0).
-        sketch.update(0, &sightings([0.0, 0.0], 1.5));
-        sketch.update(1, &sightings([8.0, 0.0], -1.5));
+        sketch.update(0, &sightings([0.0, 0.0], 1.5), &[]);
+        sketch.update(1, &sightings([8.0, 0.0], -1.5), &[]);
         let placed = sketch.frame(2).landmarks[0].1;
         assert!(distance(placed.point, rock) < 0.2, "{placed:?}");
         assert!(placed.reach() < 0.4, "{placed:?}");
@@ -274,7 +301,7 @@ mod tests {
     #[test]
     fn landmarks_leave_after_the_window_and_a_lost_sketch_starts_again() {
         let mut sketch = Sketch::default();
-        sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]));
+        sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]), &[]);
         assert_eq!(sketch.frame(WINDOW).landmarks.len(), 4);
         assert!(sketch.frame(WINDOW + 1).landmarks.is_empty());
         // Two unrelated rocks share nothing with the sketch: left out while it may be found
@@ -282,8 +309,8 @@ mod tests {
         let departed = sketch.frame(WINDOW + 1).departed;
         assert_eq!(departed.len(), 4, "kept where they were last placed");
         let elsewhere = seen(0.0, [50.0, 0.0], &[4, 5]);
-        assert!(!sketch.update(5, &elsewhere));
-        assert!(sketch.update(WINDOW + 1, &elsewhere));
+        assert!(!sketch.update(5, &elsewhere, &[]));
+        assert!(sketch.update(WINDOW + 1, &elsewhere, &[]));
         let frame = sketch.frame(WINDOW + 1);
         let ids: Vec<LandmarkId> = frame.landmarks.iter().map(|l| l.0).collect();
         assert_eq!(ids, vec![4, 5]);
@@ -296,13 +323,13 @@ mod tests {
     #[test]
     fn a_departed_landmark_seen_again_rejoins_the_sketch() {
         let mut sketch = Sketch::default();
-        sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]));
-        sketch.update(WINDOW, &seen(0.0, [0.0, 0.0], &[1, 2, 3]));
+        sketch.update(0, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]), &[]);
+        sketch.update(WINDOW, &seen(0.0, [0.0, 0.0], &[1, 2, 3]), &[]);
         let frame = sketch.frame(WINDOW + 1);
         let departed: Vec<LandmarkId> = frame.departed.iter().map(|d| d.0).collect();
         assert_eq!(departed, vec![0]);
         assert!(distance(frame.departed[0].1.point, FIELD[0]) < 1e-9);
-        sketch.update(WINDOW + 2, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]));
+        sketch.update(WINDOW + 2, &seen(0.0, [0.0, 0.0], &[0, 1, 2, 3]), &[]);
         let frame = sketch.frame(WINDOW + 2);
         assert!(frame.departed.is_empty());
         assert!(frame.landmarks.iter().any(|l| l.0 == 0));

@@ -9,7 +9,7 @@ use super::selection;
 use crate::association::audit::{regroup, Regrouping};
 use crate::association::{
     agreement, associate, reconsider, sketch, AssociationSettings, Decision, Evidence, Frame,
-    Gallery, LastSeen, Placed, Profile, Sketch,
+    Gallery, LastSeen, Placed, Profile, Sketch, StationEvidence,
 };
 use crate::calib::Calibration;
 use crate::detection::{Detection, Separation};
@@ -231,8 +231,7 @@ impl<C: Calculus> Mapper<C> {
                 };
             }
         }
-        let associated =
-            Associated::new(usable, evidence.detections, decisions, self.next_landmark);
+        let associated = Associated::new(usable, evidence, decisions, self.next_landmark);
         self.apply_size_cue(station, &mut ranged, &associated);
         for (i, r) in ranged.iter().enumerate() {
             record.detections[i].range = detection_record(&station.primary[i], r).range;
@@ -372,13 +371,15 @@ impl<C: Calculus> Mapper<C> {
         let frame = Frame {
             accumulated: false,
             departed: Vec::new(),
+            unmapped: associated.unmapped(),
             landmarks: associated
                 .fused
                 .iter()
                 .filter_map(|s| Some((s.landmark, associated.evidence[s.position].placed?)))
                 .collect(),
         };
-        self.sketch.update(record.index, &frame.landmarks);
+        self.sketch
+            .update(record.index, &frame.landmarks, &frame.unmapped);
         self.sighted.push(Sighted {
             station: record.index,
             bearings: associated
@@ -735,6 +736,8 @@ fn detection_record(d: &Detection, r: &Ranged) -> DetectionRecord {
 struct Associated {
     usable: Vec<usize>,
     evidence: Vec<Evidence>,
+    /// Placements of the station's detections mapping does not use.
+    unused: Vec<Placed>,
     decisions: Vec<Decision>,
     fused: Vec<Sighting>,
     held: Vec<(usize, Vec<LandmarkId>)>,
@@ -743,9 +746,19 @@ struct Associated {
 }
 
 impl Associated {
+    /// The rocks the station saw that it fused into no landmark: detections held back or
+    /// founding none, and those mapping does not use.
+    fn unmapped(&self) -> Vec<Placed> {
+        (0..self.evidence.len())
+            .filter(|&position| !self.fused.iter().any(|s| s.position == position))
+            .filter_map(|position| self.evidence[position].placed)
+            .chain(self.unused.iter().copied())
+            .collect()
+    }
+
     fn new(
         usable: Vec<usize>,
-        evidence: Vec<Evidence>,
+        station: StationEvidence,
         decisions: Vec<Decision>,
         mut next_landmark: LandmarkId,
     ) -> Associated {
@@ -764,7 +777,8 @@ impl Associated {
         }
         Associated {
             usable,
-            evidence,
+            evidence: station.detections,
+            unused: station.unused_placed,
             decisions,
             fused,
             held,

@@ -93,6 +93,10 @@ pub(crate) fn station_evidence(
             .filter(|i| !usable.contains(i))
             .map(|i| ranged[i].ray)
             .collect(),
+        unused_placed: (0..ranged.len())
+            .filter(|i| !usable.contains(i))
+            .filter_map(|i| placed(&ranged[i]))
+            .collect(),
     }
 }
 
