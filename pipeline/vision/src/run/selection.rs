@@ -76,6 +76,10 @@ pub(crate) fn station_evidence(
     usable: &[usize],
     model: &SensorModel,
 ) -> StationEvidence {
+    let unused: Vec<&Ranged> = (0..ranged.len())
+        .filter(|i| !usable.contains(i))
+        .map(|i| &ranged[i])
+        .collect();
     StationEvidence {
         view: view_of(ranged, usable),
         detections: usable
@@ -89,14 +93,8 @@ pub(crate) fn station_evidence(
             })
             .collect(),
         colour: station.channels == Channels::Colour,
-        unused: (0..ranged.len())
-            .filter(|i| !usable.contains(i))
-            .map(|i| ranged[i].ray)
-            .collect(),
-        unused_placed: (0..ranged.len())
-            .filter(|i| !usable.contains(i))
-            .filter_map(|i| placed(&ranged[i]))
-            .collect(),
+        unused: unused.iter().map(|r| r.ray).collect(),
+        unused_placed: unused.iter().filter_map(|r| placed(r)).collect(),
     }
 }
 
