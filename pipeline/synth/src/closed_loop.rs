@@ -21,11 +21,20 @@
 //! landmark of the route is not identified in a panorama, the rover drives on its last
 //! bearing if it was seen in the last 6 steps (the rover keeps its heading, so bearings stay
 //! good); otherwise it re-plans from its cell: the cheapest of the 5 cheapest routes whose
-//! next landmark is in view, or, with none, a step on the goal's last bearing if it was ever
-//! seen (at most 5 re-plans); else the trip is lost. When the follower arrives (the goal is
-//! the nearest identified landmark) but a detection not identified may be nearer still, the
-//! rover closes in on the goal for up to 8 more steps until the panorama proves it the
-//! nearest of all.
+//! next landmark is in view, or, with none, the cheapest route from a landmark in view (the
+//! rover drives to that landmark first), or, with nothing identified that leads to the goal, a
+//! step on the goal's last bearing if it was ever seen (at most 5 re-plans); else the trip is
+//! lost. When the follower arrives (the goal is the nearest identified landmark) but a
+//! detection not identified may be nearer still, the rover closes in on the goal for up to 8
+//! more steps until the panorama proves it the nearest of all.
+//!
+//! The camera cannot see the ground near the rover: below the panorama's bottom row lies a
+//! blind zone (2.1 m of flat ground from a 1.5 m mast at marsyard's calibration), and a rock
+//! the rover drives up to leaves the view through the panorama's foot before the rover is in
+//! its cell, so the range order can never show it nearest. A route landmark last identified
+//! at the foot of the view (its lowest row showing ground within one step of the blind zone)
+//! that is gone from there (no detection at the foot on its bearing) is therefore *reached*:
+//! its leg ends as if the range order had shown it nearest.
 //!
 //! The rover keeps its heading (a holonomic rover, or one that turns back after each step):
 //! bearings are in the panorama's frame, and the step is taken in that frame. Success is
@@ -43,6 +52,7 @@ use qrm_core::geometry::Point;
 use qrm_core::map::LandmarkId;
 use qrm_core::navigation::{cell_of, Cell, Command, LegFollower, Route, RouteCost, RouteGraph};
 use qrm_vision::calib::Calibration;
+use qrm_vision::detection::Detection;
 use qrm_vision::localization::{KnownMap, Whereabouts};
 use qrm_vision::ranging::PrimaryEye;
 use qrm_vision::run::front_end::detect_panoramas;
@@ -65,6 +75,11 @@ const MEMORY_STEPS: usize = 6;
 /// Steps the rover closes in on the goal once it is the nearest identified landmark, until the
 /// panorama proves it nearer than every detection.
 const APPROACH_STEPS: usize = 8;
+/// How far to either side of a landmark's last bearing a detection at the panorama's foot
+/// shows that the landmark is still in view, radians: the bearing of a rock near the rover
+/// moves with the rover's step, and the primary eye sits half the stereo baseline off the
+/// mast.
+const STILL_IN_VIEW_RAD: f64 = 5.0 * std::f64::consts::PI / 180.0;
 
 /// How the rover drives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -240,7 +255,8 @@ pub fn drive(
     let mut follower: Option<LegFollower> = None;
     // The last bearing each landmark was seen at, and how many steps ago: the rover keeps its
     // heading, so a bearing stays good for a few steps while its landmark is not identified.
-    let mut last_seen: BTreeMap<LandmarkId, (f64, usize)> = BTreeMap::new();
+    let mut last_seen: BTreeMap<LandmarkId, Sighted> = BTreeMap::new();
+    let foot_row = foot_row(terrain.calib, driving.step_m);
     let mut approach = 0;
     let mut avoidance = HazardAvoidance::default();
     for index in 0..driving.max_steps {
@@ -264,10 +280,18 @@ pub fn drive(
         );
         let (visible, view) = &location.seen;
         for seen in last_seen.values_mut() {
-            seen.1 += 1;
+            seen.ago += 1;
         }
-        for (i, &l) in visible.iter().enumerate() {
-            last_seen.insert(l, (view.bearings[i].angle, 0));
+        for (i, (&(d, l), bearing)) in location.identified.iter().zip(&view.bearings).enumerate() {
+            debug_assert_eq!(visible[i], l);
+            last_seen.insert(
+                l,
+                Sighted {
+                    bearing: bearing.angle,
+                    ago: 0,
+                    at_foot: f64::from(detections.primary[d].bbox[3]) + 1.0 >= foot_row,
+                },
+            );
         }
         // The cell the follower believes it is in: the nearest identified landmark.
         let here = match cell_of(visible, &view.order) {
@@ -309,15 +333,32 @@ pub fn drive(
             trip.route = route.landmarks.clone();
             follower = Some(LegFollower::new(&route));
         }
-        let mut command = follower
-            .as_mut()
-            .expect("planned above")
-            .step(visible, view);
+        let leg = follower.as_mut().expect("planned above");
+        let mut command = leg.step(visible, view);
+        // A route landmark that left the view at its foot is under the camera: reached.
+        while let Command::TargetLost(target) = command {
+            match last_seen.get(&target) {
+                Some(seen)
+                    if seen.ago <= MEMORY_STEPS
+                        && seen.at_foot
+                        && left_view(
+                            seen.bearing,
+                            &detections.primary,
+                            terrain.calib,
+                            foot_row,
+                        ) =>
+                {
+                    leg.reached(target);
+                    command = leg.step(visible, view);
+                }
+                _ => break,
+            }
+        }
         if let Command::TargetLost(target) = command {
             command = match last_seen.get(&target) {
-                Some(&(bearing, ago)) if ago <= MEMORY_STEPS => Command::Toward {
+                Some(seen) if seen.ago <= MEMORY_STEPS => Command::Toward {
                     landmark: target,
-                    bearing,
+                    bearing: seen.bearing,
                 },
                 _ => match replan(graph, here, goal, driving.cost, visible, trip.replans) {
                     Some(route) => {
@@ -330,11 +371,11 @@ pub fn drive(
                     // No route's next landmark in view: head for where the goal was last
                     // seen, if ever, and look again from there.
                     None => match last_seen.get(&goal) {
-                        Some(&(bearing, _)) if trip.replans < REPLANS => {
+                        Some(seen) if trip.replans < REPLANS => {
                             trip.replans += 1;
                             Command::Toward {
                                 landmark: goal,
-                                bearing,
+                                bearing: seen.bearing,
                             }
                         }
                         _ => command,
@@ -349,11 +390,11 @@ pub fn drive(
             && location.whereabouts != (Whereabouts::Certain { landmark: goal })
             && approach < APPROACH_STEPS
         {
-            if let Some(&(bearing, _)) = last_seen.get(&goal).filter(|s| s.1 <= MEMORY_STEPS) {
+            if let Some(seen) = last_seen.get(&goal).filter(|s| s.ago <= MEMORY_STEPS) {
                 approach += 1;
                 command = Command::Toward {
                     landmark: goal,
-                    bearing,
+                    bearing: seen.bearing,
                 };
             }
         }
@@ -392,8 +433,48 @@ pub fn drive(
     trip
 }
 
+/// What the rover last saw of a landmark.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Sighted {
+    /// Bearing in the panorama's frame, radians.
+    bearing: f64,
+    /// Steps since.
+    ago: usize,
+    /// Its detection reached the panorama's foot ([`foot_row`]).
+    at_foot: bool,
+}
+
+/// The first row of the panorama's foot: below it lies flat ground within one step of the
+/// nearest ground the camera sees, so a rock reaching it may be under the camera after the
+/// next step.
+fn foot_row(calib: &Calibration, step_m: f64) -> f64 {
+    let bottom = f64::from(calib.image.height);
+    calib
+        .ground_range(bottom)
+        .map_or(bottom, |nearest| calib.ground_row(nearest + step_m))
+}
+
+/// Whether no detection reaching the panorama's foot lies on `bearing` (within
+/// [`STILL_IN_VIEW_RAD`]): a rock last seen at the foot on that bearing has left the view
+/// under the camera. A farther rock behind it, now uncovered, does not reach the foot.
+fn left_view(bearing: f64, detections: &[Detection], calib: &Calibration, foot_row: f64) -> bool {
+    let width = f64::from(calib.image.width);
+    let margin = STILL_IN_VIEW_RAD / calib.column_width();
+    let column = calib.column(bearing);
+    !detections.iter().any(|d| {
+        let (first, last) = (f64::from(d.bbox[0]), f64::from(d.bbox[2]) + 1.0);
+        // A blob straddling the seam has columns past the width.
+        f64::from(d.bbox[3]) + 1.0 >= foot_row
+            && [column, column + width]
+                .iter()
+                .any(|&c| c >= first - margin && c <= last + margin)
+    })
+}
+
 /// A route from the rover's cell `here` to `goal` whose first landmark to drive to is in view
-/// (`visible`): the cheapest of the few cheapest routes; none once [`REPLANS`] are used.
+/// (`visible`): the cheapest of the few cheapest routes. With none (the cell is wrong, or its
+/// routes' next landmarks are not identified), the cheapest route from a landmark in view,
+/// which the rover drives to first. None once [`REPLANS`] are used.
 fn replan(
     graph: &RouteGraph,
     here: Option<LandmarkId>,
@@ -405,14 +486,22 @@ fn replan(
     if replans >= REPLANS {
         return None;
     }
-    graph
-        .alternatives(here?, goal, cost, ALTERNATIVES)
-        .ok()?
-        .into_iter()
-        .find(|r| {
-            let next = r.landmarks.get(1).unwrap_or(&r.landmarks[0]);
-            visible.contains(next)
-        })
+    let from_here = here.and_then(|here| {
+        graph
+            .alternatives(here, goal, cost, ALTERNATIVES)
+            .ok()?
+            .into_iter()
+            .find(|r| {
+                let next = r.landmarks.get(1).unwrap_or(&r.landmarks[0]);
+                visible.contains(next)
+            })
+    });
+    from_here.or_else(|| {
+        visible
+            .iter()
+            .filter_map(|&v| graph.plan(v, goal, cost).ok())
+            .min_by(|a, b| a.cost.total_cmp(&b.cost))
+    })
 }
 
 /// One step from `pose` toward `bearing` (the panorama's frame), around the rocks in the way
@@ -441,4 +530,108 @@ fn step(
         trip.collisions += 1;
     }
     next
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::default_calibration;
+    use qrm_core::neighborhood::{RngEdge, RngEstimate};
+    use qrm_vision::detection::{Appearance, Separation};
+
+    fn rock(columns: [u32; 2], rows: [u32; 2]) -> Detection {
+        Detection {
+            centroid: [
+                f64::from(columns[0] + columns[1]) / 2.0 + 0.5,
+                f64::from(rows[0] + rows[1]) / 2.0 + 0.5,
+            ],
+            bbox: [columns[0], rows[0], columns[1], rows[1]],
+            pixels: 100,
+            contact_row: f64::from(rows[1] + 1),
+            contact_slack_rows: 0.0,
+            appearance: Appearance {
+                colour: [0.4, 0.33, 0.27],
+                brightness: 0.8,
+                texture: 0.1,
+                dark_fraction: 0.2,
+            },
+            ambiguous: false,
+            separation: Separation::Whole,
+            blob: 0,
+            beyond_columns: [0, 0],
+            parallax_shifts: None,
+        }
+    }
+
+    #[test]
+    fn the_foot_shows_ground_within_one_step_of_the_blind_zone() {
+        let calib = default_calibration();
+        let bottom = f64::from(calib.image.height);
+        let nearest = calib
+            .ground_range(bottom)
+            .expect("the bottom row looks down");
+        // 1.5 m mast, 35.7° below the horizon at the bottom row.
+        assert!((nearest - 2.09).abs() < 0.01, "{nearest}");
+        let row = foot_row(&calib, 0.5);
+        assert!(row < bottom);
+        let at_row = calib.ground_range(row).expect("below the horizon");
+        assert!((at_row - (nearest + 0.5)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_rock_has_left_the_view_when_nothing_at_the_foot_lies_on_its_bearing() {
+        let calib = default_calibration();
+        let foot = foot_row(&calib, 0.5);
+        let (first_foot_row, bottom) = (foot.ceil() as u32, calib.image.height - 1);
+        let bearing = calib.azimuth(1000.5);
+        let on_bearing = rock([990, 1010], [first_foot_row, bottom]);
+        // A farther rock on the same bearing, uncovered once the near one is under the camera.
+        let behind = rock([995, 1005], [200, first_foot_row - 20]);
+        // A near rock 90 columns (7.9°) aside.
+        let aside = rock([1091, 1150], [first_foot_row, bottom]);
+        assert!(!left_view(bearing, &[on_bearing], &calib, foot));
+        assert!(left_view(bearing, &[behind, aside], &calib, foot));
+        assert!(left_view(bearing, &[], &calib, foot));
+        // 4° past a rock's side, the rock may still be the one last seen.
+        let within = rock([1046, 1100], [first_foot_row, bottom]);
+        assert!(!left_view(bearing, &[within], &calib, foot));
+        // A blob straddling the seam covers the first columns too.
+        let width = calib.image.width;
+        let straddling = rock([width - 10, width + 10], [first_foot_row, bottom]);
+        assert!(!left_view(calib.azimuth(2.5), &[straddling], &calib, foot));
+    }
+
+    #[test]
+    fn replanning_starts_from_a_landmark_in_view_when_no_route_from_the_cell_is() {
+        // 0–1–2–3–4, goal 4.
+        let rng = RngEstimate {
+            edges: [(0, 1), (1, 2), (2, 3), (3, 4)]
+                .iter()
+                .map(|&(a, b)| RngEdge { a, b, cost: 0.0 })
+                .collect(),
+            pruned: 0,
+        };
+        let graph = RouteGraph::new(&[0, 1, 2, 3, 4], &rng);
+        let cost = RouteCost { lambda: 1.0 };
+        let landmarks = |route: Option<Route>| route.map(|r| r.landmarks);
+        // The cell's route, its next landmark in view.
+        assert_eq!(
+            landmarks(replan(&graph, Some(0), 4, cost, &[1, 3], 0)),
+            Some(vec![0, 1, 2, 3, 4])
+        );
+        // Its next landmark not in view: drive to the landmark in view nearest the goal first.
+        assert_eq!(
+            landmarks(replan(&graph, Some(0), 4, cost, &[2, 3], 0)),
+            Some(vec![3, 4])
+        );
+        assert_eq!(
+            landmarks(replan(&graph, None, 4, cost, &[2], 0)),
+            Some(vec![2, 3, 4])
+        );
+        assert_eq!(landmarks(replan(&graph, Some(0), 4, cost, &[], 0)), None);
+        assert_eq!(
+            landmarks(replan(&graph, Some(0), 4, cost, &[1], REPLANS)),
+            None
+        );
+    }
 }

@@ -35,6 +35,15 @@ impl LegFollower {
         }
     }
 
+    /// Ends the leg toward `landmark` if it is the current target: the caller knows the rover
+    /// reached it without the range order showing it (a rock near the rover is under a mast
+    /// camera's view, where no panorama shows it nearest).
+    pub fn reached(&mut self, landmark: LandmarkId) {
+        if self.route.get(self.next) == Some(&landmark) {
+            self.next += 1;
+        }
+    }
+
     /// The command for a panorama showing landmarks `visible` (by view position) as `view`.
     /// A leg ends only when its landmark is *certainly* the nearest (seed digest A.6, 4).
     pub fn step(&mut self, visible: &[LandmarkId], view: &StationView) -> Command {
@@ -125,5 +134,33 @@ mod tests {
         );
         let without_two = view(&[0.5], &[0]);
         assert_eq!(follower.step(&[1], &without_two), Command::TargetLost(2));
+    }
+
+    #[test]
+    fn a_leg_reached_out_of_view_ends_and_only_the_current_one() {
+        let mut follower = LegFollower::new(&route(&[1, 2, 3]));
+        let far = view(&[0.5, 1.5, 2.5], &[0, 1, 2]);
+        // Not the current target: nothing changes.
+        follower.reached(2);
+        assert_eq!(
+            follower.step(&[1, 2, 3], &far),
+            Command::Toward {
+                landmark: 2,
+                bearing: 1.5
+            }
+        );
+        // Landmark 2 is under the camera: its leg ends though the panorama does not show it.
+        let without_two = view(&[0.5, 2.5], &[0, 1]);
+        assert_eq!(follower.step(&[1, 3], &without_two), Command::TargetLost(2));
+        follower.reached(2);
+        assert_eq!(
+            follower.step(&[1, 3], &without_two),
+            Command::Toward {
+                landmark: 3,
+                bearing: 2.5
+            }
+        );
+        follower.reached(3);
+        assert_eq!(follower.step(&[1], &view(&[0.5], &[0])), Command::Arrived);
     }
 }
