@@ -29,12 +29,12 @@
 //! more steps until the panorama proves it the nearest of all.
 //!
 //! The camera cannot see the ground near the rover: below the panorama's bottom row lies a
-//! blind zone (2.1 m of flat ground from a 1.5 m mast at marsyard's calibration), and a rock
-//! the rover drives up to leaves the view through the panorama's foot before the rover is in
-//! its cell, so the range order can never show it nearest. A route landmark last identified
-//! at the foot of the view (its lowest row showing ground within one step of the blind zone)
-//! that is gone from there (no detection at the foot on its bearing) is therefore *reached*:
-//! its leg ends as if the range order had shown it nearest.
+//! blind zone (2.1 m of flat ground from a 1.5 m mast at marsyard's calibration). A rock the
+//! rover drives up to often leaves the view through the panorama's foot before the rover is
+//! in its cell, and from there no range order can show it nearest. A route landmark last
+//! identified at the foot of the view (its lowest row showing ground within one step of the
+//! blind zone) that is gone from there (no detection at the foot on its bearing) is therefore
+//! *reached*: its leg ends as if the range order had shown it nearest.
 //!
 //! The rover keeps its heading (a holonomic rover, or one that turns back after each step):
 //! bearings are in the panorama's frame, and the step is taken in that frame. Success is
