@@ -289,7 +289,7 @@ pub fn drive(
                 Sighted {
                     bearing: bearing.angle,
                     ago: 0,
-                    at_foot: f64::from(detections.primary[d].bbox[3]) + 1.0 >= foot_row,
+                    at_foot: reaches_foot(&detections.primary[d], foot_row),
                 },
             );
         }
@@ -454,6 +454,11 @@ fn foot_row(calib: &Calibration, step_m: f64) -> f64 {
         .map_or(bottom, |nearest| calib.ground_row(nearest + step_m))
 }
 
+/// Whether detection `d`'s lowest row (its bottom edge) reaches the foot ([`foot_row`]).
+fn reaches_foot(d: &Detection, foot_row: f64) -> bool {
+    f64::from(d.bbox[3]) + 1.0 >= foot_row
+}
+
 /// Whether no detection reaching the panorama's foot lies on `bearing` (within
 /// [`STILL_IN_VIEW_RAD`]): a rock last seen at the foot on that bearing has left the view
 /// under the camera. A farther rock behind it, now uncovered, does not reach the foot.
@@ -464,7 +469,7 @@ fn left_view(bearing: f64, detections: &[Detection], calib: &Calibration, foot_r
     !detections.iter().any(|d| {
         let (first, last) = (f64::from(d.bbox[0]), f64::from(d.bbox[2]) + 1.0);
         // A blob straddling the seam has columns past the width.
-        f64::from(d.bbox[3]) + 1.0 >= foot_row
+        reaches_foot(d, foot_row)
             && [column, column + width]
                 .iter()
                 .any(|&c| c >= first - margin && c <= last + margin)
