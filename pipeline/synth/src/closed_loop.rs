@@ -36,13 +36,26 @@
 //! blind zone) that is gone from there (no detection at the foot on its bearing) is therefore
 //! *reached*: its leg ends as if the range order had shown it nearest.
 //!
+//! Between sightings the rover dead-reckons (its steps as its wheels measured them) where a
+//! landmark's rock is: its last bearing and the flat-ground range of its contact row give the
+//! rock's near side. A route landmark driven on its last bearing as far as its near side, less
+//! the clearance the hazard cameras keep, is *reached* too: driving on would pass it.
+//!
+//! A rover that has arrived may still stand in a neighbour's cell: the goal is the nearest rock
+//! the panorama shows, and a rock under the camera may be nearer. So once the follower
+//! arrives, the rover closes in on the goal ([`final_approach`]): straight at the goal's near
+//! side by dead reckoning, until the hazard cameras stop it [`CLEARANCE_M`] from a rock. The
+//! goal's cell is convex and holds the goal, so this never leaves the cell once in it. The
+//! hazard cameras (as [`HazardAvoidance`]) only say how far the way ahead is clear, never
+//! where to go.
+//!
 //! The rover keeps its heading (a holonomic rover, or one that turns back after each step):
 //! bearings are in the panorama's frame, and the step is taken in that frame. Success is
 //! judged against the truth only after the trip: the rover stopped in the goal landmark's
 //! Voronoi cell (the landmark whose rock is nearest to it).
 
 use crate::clearance_grid::grown_footprints;
-use crate::hazard_avoidance::HazardAvoidance;
+use crate::hazard_avoidance::{clear_run, HazardAvoidance};
 use crate::reference_path::shortest_path_m;
 use crate::render::{render, Eye, Pose};
 use crate::world::World;
@@ -75,6 +88,8 @@ const MEMORY_STEPS: usize = 6;
 /// Steps the rover closes in on the goal once it is the nearest identified landmark, until the
 /// panorama proves it nearer than every detection.
 const APPROACH_STEPS: usize = 8;
+/// Shortest straight run of the final approach worth a step, metres.
+const MIN_APPROACH_M: f64 = 0.05;
 /// How far to either side of a landmark's last bearing a detection at the panorama's foot
 /// shows that the landmark is still in view, radians: the bearing of a rock near the rover
 /// moves with the rover's step, and the primary eye sits half the stereo baseline off the
@@ -153,8 +168,8 @@ pub struct StepLog {
     pub detections: usize,
     /// The cell the follower believes it is in (the nearest identified landmark).
     pub cell: Option<LandmarkId>,
-    /// `toward`, `arrived`, `lost`, or at a first step that cannot start, `start_unknown` or
-    /// `no_route`.
+    /// `toward`, `closing_in` (the final approach to the goal), `arrived`, `lost`, or at a
+    /// first step that cannot start, `start_unknown` or `no_route`.
     pub command: &'static str,
     /// The landmark driven toward, and its bearing in the panorama's frame, degrees.
     pub target: Option<LandmarkId>,
@@ -258,6 +273,9 @@ pub fn drive(
     let mut last_seen: BTreeMap<LandmarkId, Sighted> = BTreeMap::new();
     let foot_row = foot_row(terrain.calib, driving.step_m);
     let mut approach = 0;
+    // The rover's dead reckoning in the panorama's frame: the sum of its steps as its wheels
+    // measured them (exact in the simulation). Used only between sightings of a landmark.
+    let mut odometry = Point::new(0.0, 0.0);
     let mut avoidance = HazardAvoidance::default();
     for index in 0..driving.max_steps {
         let (left, right) = terrain.panoramas(pose);
@@ -284,12 +302,15 @@ pub fn drive(
         }
         for (i, (&(d, l), bearing)) in location.identified.iter().zip(&view.bearings).enumerate() {
             debug_assert_eq!(visible[i], l);
+            let detection = &detections.primary[d];
             last_seen.insert(
                 l,
                 Sighted {
                     bearing: bearing.angle,
                     ago: 0,
-                    at_foot: reaches_foot(&detections.primary[d], foot_row),
+                    at_foot: reaches_foot(detection, foot_row),
+                    range_m: terrain.calib.ground_range(detection.contact_row),
+                    odometry,
                 },
             );
         }
@@ -335,18 +356,20 @@ pub fn drive(
         }
         let leg = follower.as_mut().expect("planned above");
         let mut command = leg.step(visible, view);
-        // A route landmark that left the view at its foot is under the camera: reached.
+        // A route landmark that left the view at its foot is under the camera, and one the
+        // rover has driven up to is beside it: reached.
         while let Command::TargetLost(target) = command {
             match last_seen.get(&target) {
                 Some(seen)
                     if seen.ago <= MEMORY_STEPS
-                        && seen.at_foot
-                        && left_view(
-                            seen.bearing,
-                            &detections.primary,
-                            terrain.calib,
-                            foot_row,
-                        ) =>
+                        && (seen.driven_up_to(odometry)
+                            || seen.at_foot
+                                && left_view(
+                                    seen.bearing,
+                                    &detections.primary,
+                                    terrain.calib,
+                                    foot_row,
+                                )) =>
                 {
                     leg.reached(target);
                     command = leg.step(visible, view);
@@ -390,7 +413,10 @@ pub fn drive(
             && location.whereabouts != (Whereabouts::Certain { landmark: goal })
             && approach < APPROACH_STEPS
         {
-            if let Some(seen) = last_seen.get(&goal).filter(|s| s.ago <= MEMORY_STEPS) {
+            if let Some(seen) = last_seen
+                .get(&goal)
+                .filter(|s| s.ago <= MEMORY_STEPS && !s.driven_up_to(odometry))
+            {
                 approach += 1;
                 command = Command::Toward {
                     landmark: goal,
@@ -398,10 +424,21 @@ pub fn drive(
                 };
             }
         }
-        let (name, target, bearing) = match command {
-            Command::Arrived => ("arrived", None, None),
-            Command::Toward { landmark, bearing } => ("toward", Some(landmark), Some(bearing)),
-            Command::TargetLost(landmark) => ("lost", Some(landmark), None),
+        // Arrived: close in on the goal, straight, until the hazard cameras stop the rover.
+        let closing = match command {
+            Command::Arrived => last_seen
+                .get(&goal)
+                .filter(|s| s.ago <= MEMORY_STEPS)
+                .and_then(|seen| final_approach(terrain, pose, seen, odometry, driving.step_m)),
+            _ => None,
+        };
+        let (name, target, bearing) = match (command, closing) {
+            (_, Some((bearing, _))) => ("closing_in", Some(goal), Some(bearing)),
+            (Command::Arrived, None) => ("arrived", None, None),
+            (Command::Toward { landmark, bearing }, None) => {
+                ("toward", Some(landmark), Some(bearing))
+            }
+            (Command::TargetLost(landmark), None) => ("lost", Some(landmark), None),
         };
         log(&mut trip, name, target, bearing);
         let Some(bearing) = bearing else {
@@ -413,18 +450,29 @@ pub fn drive(
             break;
         };
         let avoided = trip.avoided;
-        let next = step(
-            terrain,
-            &mut avoidance,
-            pose,
-            bearing,
-            driving.step_m,
-            &mut trip,
-        );
+        let next = match closing {
+            Some((_, run)) => {
+                // The follower has arrived; the approach only brings the rover nearer.
+                trip.outcome = Outcome::Arrived;
+                approach = APPROACH_STEPS;
+                ahead(pose, bearing, run)
+            }
+            None => step(
+                terrain,
+                &mut avoidance,
+                pose,
+                bearing,
+                driving.step_m,
+                &mut trip,
+            ),
+        };
         if let Some(log) = trip.steps.last_mut() {
             log.avoided = trip.avoided > avoided;
         }
         trip.length_m += pose.position.distance(next);
+        let (dx, dy) = (next.x - pose.position.x, next.y - pose.position.y);
+        let (sin, cos) = pose.heading.sin_cos();
+        odometry = odometry + Point::new(dx * cos + dy * sin, dy * cos - dx * sin);
         pose.position = next;
         trip.path.push([next.x, next.y]);
     }
@@ -442,6 +490,74 @@ struct Sighted {
     ago: usize,
     /// Its detection reached the panorama's foot ([`foot_row`]).
     at_foot: bool,
+    /// Flat-ground range of its detection's contact row then, metres: how far its rock's near
+    /// side was. A rock cut off by the panorama's foot has its contact nearer than the bottom
+    /// row's ground, so its range is then too far.
+    range_m: Option<f64>,
+    /// The rover's dead reckoning then (the panorama's frame).
+    odometry: Point,
+}
+
+impl Sighted {
+    /// Where the rock's near side is, by dead reckoning (the panorama's frame).
+    fn near_side(&self) -> Option<Point> {
+        let range = self.range_m?;
+        let (sin, cos) = self.bearing.sin_cos();
+        Some(self.odometry + Point::new(range * cos, range * sin))
+    }
+
+    /// Whether the rover, at dead reckoning `odometry`, has driven up to the rock: as far on
+    /// its last bearing as its near side less [`CLEARANCE_M`], where the hazard cameras keep
+    /// the rover. Driving on the last bearing any farther passes the rock.
+    fn driven_up_to(&self, odometry: Point) -> bool {
+        let (Some(range), (sin, cos)) = (self.range_m, self.bearing.sin_cos()) else {
+            return false;
+        };
+        let driven = odometry - self.odometry;
+        driven.x * cos + driven.y * sin >= range - CLEARANCE_M
+    }
+}
+
+/// The final approach's next step once the follower has arrived, from dead reckoning
+/// `odometry`: the bearing of the goal's near side ([`Sighted::near_side`]), and how far to
+/// drive straight on it, up to the near side, up to where the hazard cameras stop the rover
+/// [`CLEARANCE_M`] from a rock ([`clear_run`]), and at most one step. `None` when the rover
+/// can drive no nearer.
+///
+/// Why: arriving by range order, or by the goal leaving the view at its foot, leaves the rover
+/// anywhere up to the blind zone's 2.1 m from the goal, where a neighbour under the camera is
+/// often nearer. A Voronoi cell is convex and holds its landmark, so driving straight at the
+/// goal never leaves its cell once in it, and ends in it near enough to the rock.
+fn final_approach(
+    terrain: &Terrain,
+    pose: Pose,
+    seen: &Sighted,
+    odometry: Point,
+    step_m: f64,
+) -> Option<(f64, f64)> {
+    let way = seen.near_side()? - odometry;
+    let (left, bearing) = (way.x.hypot(way.y), way.y.atan2(way.x));
+    if left < MIN_APPROACH_M {
+        return None;
+    }
+    let azimuth = pose.heading + bearing;
+    let run = clear_run(
+        terrain.world,
+        pose.position,
+        azimuth,
+        left.min(step_m),
+        CLEARANCE_M,
+    );
+    (run >= MIN_APPROACH_M).then_some((bearing, run))
+}
+
+/// The point `length` metres from `pose` straight on `bearing` (the panorama's frame).
+fn ahead(pose: Pose, bearing: f64, length: f64) -> Point {
+    let azimuth = pose.heading + bearing;
+    Point::new(
+        pose.position.x + length * azimuth.cos(),
+        pose.position.y + length * azimuth.sin(),
+    )
 }
 
 /// The first row of the panorama's foot: below it lies flat ground within one step of the
@@ -520,13 +636,15 @@ fn step(
     trip: &mut Trip,
 ) -> Point {
     let from = pose.position;
-    let azimuth = pose.heading + bearing;
-    let straight = Point::new(
-        from.x + length * azimuth.cos(),
-        from.y + length * azimuth.sin(),
-    );
+    let straight = ahead(pose, bearing, length);
     let next = avoidance
-        .drive(terrain.world, from, azimuth, length, CLEARANCE_M)
+        .drive(
+            terrain.world,
+            from,
+            pose.heading + bearing,
+            length,
+            CLEARANCE_M,
+        )
         .unwrap_or(from);
     if next.distance(straight) > AVOIDED_M {
         trip.avoided += 1;
@@ -543,6 +661,7 @@ mod tests {
     use crate::default_calibration;
     use qrm_core::neighborhood::{RngEdge, RngEstimate};
     use qrm_vision::detection::{Appearance, Separation};
+    use std::f64::consts::FRAC_PI_2;
 
     fn rock(columns: [u32; 2], rows: [u32; 2]) -> Detection {
         Detection {
@@ -604,6 +723,88 @@ mod tests {
         let width = calib.image.width;
         let straddling = rock([width - 10, width + 10], [first_foot_row, bottom]);
         assert!(!left_view(calib.azimuth(2.5), &[straddling], &calib, foot));
+    }
+
+    fn sighted(bearing: f64, range_m: Option<f64>, odometry: Point) -> Sighted {
+        Sighted {
+            bearing,
+            ago: 1,
+            at_foot: true,
+            range_m,
+            odometry,
+        }
+    }
+
+    #[test]
+    fn a_rock_is_driven_up_to_once_the_rover_is_as_far_on_its_bearing_as_its_near_side() {
+        // Seen 2 m away at 90°, from dead reckoning (1, 0).
+        let seen = sighted(FRAC_PI_2, Some(2.0), Point::new(1.0, 0.0));
+        let near_side = seen.near_side().unwrap();
+        assert!(near_side.distance(Point::new(1.0, 2.0)) < 1e-12);
+        let reach = 2.0 - CLEARANCE_M;
+        assert!(!seen.driven_up_to(Point::new(1.0, reach - 0.01)));
+        assert!(seen.driven_up_to(Point::new(1.0, reach + 0.01)));
+        // Passing beside the rock counts: only the way along the bearing does.
+        assert!(!seen.driven_up_to(Point::new(3.0, 1.0)));
+        assert!(seen.driven_up_to(Point::new(0.2, 2.5)));
+        // A detection with no ground range is never driven up to.
+        let unranged = sighted(FRAC_PI_2, None, Point::new(1.0, 0.0));
+        assert!(!unranged.driven_up_to(Point::new(1.0, 9.0)));
+        assert_eq!(unranged.near_side(), None);
+    }
+
+    #[test]
+    fn the_final_approach_drives_at_the_goal_until_the_hazard_cameras_stop_it() {
+        let calib = default_calibration();
+        let world = World::generate(4, &[(Point::new(3.0, 0.0), 0.5)]);
+        let rocks = BTreeMap::from([(0, 0)]);
+        let terrain = Terrain {
+            world: &world,
+            calib: &calib,
+            landmark_rocks: &rocks,
+        };
+        // The panorama's frame turned a quarter from the world's: bearing 0 looks along +y.
+        let at = |x: f64| Pose {
+            position: Point::new(x, 0.0),
+            heading: -FRAC_PI_2,
+        };
+        // Dead reckoning after driving `x` along world +x.
+        let frame = |x: f64| Point::new(0.0, x);
+        let near_side = 3.0 - world.contact_radius(0);
+        // Seen from the start at bearing π/2 (along world +x): a whole step that way.
+        let seen = sighted(FRAC_PI_2, Some(near_side), frame(0.0));
+        let (bearing, run) = final_approach(&terrain, at(0.0), &seen, frame(0.0), 0.5).unwrap();
+        assert!((bearing - FRAC_PI_2).abs() < 1e-12 && run == 0.5);
+        // Near the rock: up to the clearance from its footprint, and no farther.
+        let stop = near_side - CLEARANCE_M;
+        let near = stop - 0.22;
+        let (_, run) = final_approach(&terrain, at(near), &seen, frame(near), 0.5).unwrap();
+        assert!(run <= 0.22 && run > 0.22 - 0.05, "{run}");
+        assert_eq!(
+            final_approach(&terrain, at(stop), &seen, frame(stop), 0.5),
+            None
+        );
+        // Dead reckoning turns the bearing toward the near side after a detour.
+        let aside = Pose {
+            position: Point::new(1.0, 1.0),
+            heading: -FRAC_PI_2,
+        };
+        let (bearing, _) =
+            final_approach(&terrain, aside, &seen, Point::new(-1.0, 1.0), 0.5).unwrap();
+        let way = Point::new(near_side - 1.0, -1.0);
+        assert!((aside.heading + bearing - way.y.atan2(way.x)).abs() < 1e-12);
+        // A goal seen at 1 m in open ground: the approach ends at its estimated near side.
+        let short = sighted(-FRAC_PI_2, Some(1.0), frame(0.0));
+        let (_, run) = final_approach(&terrain, at(0.0), &short, frame(0.0), 1.5).unwrap();
+        assert!((run - 1.0).abs() < 1e-12, "{run}");
+        let there = Point::new(0.0, -1.0);
+        assert_eq!(final_approach(&terrain, at(0.0), &short, there, 0.5), None);
+        // Never ranged: no approach.
+        let unranged = sighted(FRAC_PI_2, None, frame(0.0));
+        assert_eq!(
+            final_approach(&terrain, at(0.0), &unranged, frame(0.0), 0.5),
+            None
+        );
     }
 
     #[test]

@@ -98,6 +98,23 @@ impl HazardAvoidance {
     }
 }
 
+/// How far the rover can drive straight from `from` toward `azimuth` (world frame, radians),
+/// up to `length` metres, and keep `clearance` from every rock's footprint: where the hazard
+/// cameras stop a rover closing in on a rock (the closed loop's final approach). Sampled every
+/// [`SAMPLE_M`]; 0 when the first sample is already too near.
+pub fn clear_run(world: &World, from: Point, azimuth: f64, length: f64, clearance: f64) -> f64 {
+    let near: Vec<(Point, f64)> = grown_footprints(world, clearance)
+        .filter(|&(p, grown)| p.distance(from) < length + grown)
+        .collect();
+    let at = |d: f64| Point::new(from.x + d * azimuth.cos(), from.y + d * azimuth.sin());
+    let samples = (length / SAMPLE_M).ceil() as usize;
+    (1..=samples)
+        .map(|k| (k as f64 * SAMPLE_M).min(length))
+        .take_while(|&d| outside(&near, at(d)))
+        .last()
+        .unwrap_or(0.0)
+}
+
 /// The shortest clear path from `from` toward `subgoal` (see the module's step 4), starting at
 /// `from`; `near` are the grown footprints that reach into sight. `None` when the rover is as
 /// near to the subgoal as it can get.
@@ -194,6 +211,22 @@ mod tests {
             .unwrap();
         let straight = Point::new(0.5 * azimuth.cos(), 0.5 * azimuth.sin());
         assert!(next.distance(straight) < 1e-9, "{next:?}");
+    }
+
+    #[test]
+    fn the_clear_run_stops_the_clearance_short_of_a_rock_ahead() {
+        let world = World::generate(3, &[(Point::new(3.0, 0.0), 0.5)]);
+        let from = Point::new(0.0, 0.0);
+        let stop = 3.0 - world.contact_radius(0) - CLEARANCE;
+        let run = clear_run(&world, from, 0.0, 5.0, CLEARANCE);
+        assert!(run <= stop && run > stop - SAMPLE_M, "{run} against {stop}");
+        assert!(clear_of(&world, Point::new(run, 0.0)));
+        // Short of the rock, or away from it, the whole length is clear.
+        assert_eq!(clear_run(&world, from, 0.0, 0.73, CLEARANCE), 0.73);
+        assert_eq!(clear_run(&world, from, 1.5, 5.0, CLEARANCE), 5.0);
+        // Already at the clearance: no way ahead.
+        let at_stop = Point::new(stop + 0.01, 0.0);
+        assert_eq!(clear_run(&world, at_stop, 0.0, 1.0, CLEARANCE), 0.0);
     }
 
     #[test]
