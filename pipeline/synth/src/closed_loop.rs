@@ -37,14 +37,15 @@
 //! *reached*: its leg ends as if the range order had shown it nearest.
 //!
 //! Between sightings the rover dead-reckons (its steps as its wheels measured them) where a
-//! landmark's rock is: its last bearing and the flat-ground range of its contact row give the
-//! rock's near side. A route landmark driven on its last bearing as far as its near side, less
-//! the clearance the hazard cameras keep, is *reached* too: driving on would pass it.
+//! landmark's rock is: on its last bearing, within its range interval from all cues (ground
+//! contact, stereo, size). A route landmark driven on its last bearing as far as the nearest
+//! its rock's near side may be, less the clearance the hazard cameras keep, is *reached* too:
+//! driving on would pass it.
 //!
 //! A rover that has arrived may still stand in a neighbour's cell: the goal is the nearest rock
 //! the panorama shows, and a rock under the camera may be nearer. So once the follower
-//! arrives, the rover closes in on the goal ([`final_approach`]): straight at the goal's near
-//! side by dead reckoning, until the hazard cameras stop it [`CLEARANCE_M`] from a rock. The
+//! arrives, the rover closes in on the goal ([`final_approach`]): straight at the goal's rock
+//! by dead reckoning, until the hazard cameras stop it [`CLEARANCE_M`] from a rock. The
 //! goal's cell is convex and holds the goal, so this never leaves the cell once in it. The
 //! hazard cameras (as [`HazardAvoidance`]) only say how far the way ahead is clear, never
 //! where to go.
@@ -67,7 +68,7 @@ use qrm_core::navigation::{cell_of, Cell, Command, LegFollower, Route, RouteCost
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::Detection;
 use qrm_vision::localization::{KnownMap, Whereabouts};
-use qrm_vision::ranging::PrimaryEye;
+use qrm_vision::ranging::{PrimaryEye, RangeInterval};
 use qrm_vision::run::front_end::detect_panoramas;
 use qrm_vision::run::RunSettings;
 use serde::Serialize;
@@ -85,6 +86,11 @@ const REPLANS: usize = 5;
 const ALTERNATIVES: usize = 5;
 /// Steps for which a landmark's last bearing is driven on while it is not identified.
 const MEMORY_STEPS: usize = 6;
+/// Steps for which a landmark's rock is driven to by dead reckoning while it is not
+/// identified, when its range is bounded ([`Sighted::remembered`]).
+const DEAD_RECKONING_STEPS: usize = 12;
+/// Steps of the final approach at most ([`final_approach`]).
+const FINAL_APPROACH_STEPS: usize = 8;
 /// Steps the rover closes in on the goal once it is the nearest identified landmark, until the
 /// panorama proves it nearer than every detection.
 const APPROACH_STEPS: usize = 8;
@@ -273,6 +279,7 @@ pub fn drive(
     let mut last_seen: BTreeMap<LandmarkId, Sighted> = BTreeMap::new();
     let foot_row = foot_row(terrain.calib, driving.step_m);
     let mut approach = 0;
+    let mut closed_in = 0;
     // The rover's dead reckoning in the panorama's frame: the sum of its steps as its wheels
     // measured them (exact in the simulation). Used only between sightings of a landmark.
     let mut odometry = Point::new(0.0, 0.0);
@@ -302,14 +309,13 @@ pub fn drive(
         }
         for (i, (&(d, l), bearing)) in location.identified.iter().zip(&view.bearings).enumerate() {
             debug_assert_eq!(visible[i], l);
-            let detection = &detections.primary[d];
             last_seen.insert(
                 l,
                 Sighted {
                     bearing: bearing.angle,
                     ago: 0,
-                    at_foot: reaches_foot(detection, foot_row),
-                    range_m: terrain.calib.ground_range(detection.contact_row),
+                    at_foot: reaches_foot(&detections.primary[d], foot_row),
+                    range: Some(location.ranges[d]).filter(|r| r.high.is_finite()),
                     odometry,
                 },
             );
@@ -361,7 +367,7 @@ pub fn drive(
         while let Command::TargetLost(target) = command {
             match last_seen.get(&target) {
                 Some(seen)
-                    if seen.ago <= MEMORY_STEPS
+                    if seen.remembered()
                         && (seen.driven_up_to(odometry)
                             || seen.at_foot
                                 && left_view(
@@ -379,9 +385,9 @@ pub fn drive(
         }
         if let Command::TargetLost(target) = command {
             command = match last_seen.get(&target) {
-                Some(seen) if seen.ago <= MEMORY_STEPS => Command::Toward {
+                Some(seen) if seen.remembered() => Command::Toward {
                     landmark: target,
-                    bearing: seen.bearing,
+                    bearing: seen.bearing_from(odometry),
                 },
                 _ => match replan(graph, here, goal, driving.cost, visible, trip.replans) {
                     Some(route) => {
@@ -415,20 +421,20 @@ pub fn drive(
         {
             if let Some(seen) = last_seen
                 .get(&goal)
-                .filter(|s| s.ago <= MEMORY_STEPS && !s.driven_up_to(odometry))
+                .filter(|s| s.remembered() && !s.driven_up_to(odometry))
             {
                 approach += 1;
                 command = Command::Toward {
                     landmark: goal,
-                    bearing: seen.bearing,
+                    bearing: seen.bearing_from(odometry),
                 };
             }
         }
-        // Arrived: close in on the goal, straight, until the hazard cameras stop the rover.
+        // Arrived: close in on the goal until the hazard cameras stop the rover at it.
         let closing = match command {
-            Command::Arrived => last_seen
+            Command::Arrived if closed_in < FINAL_APPROACH_STEPS => last_seen
                 .get(&goal)
-                .filter(|s| s.ago <= MEMORY_STEPS)
+                .filter(|s| s.remembered())
                 .and_then(|seen| final_approach(terrain, pose, seen, odometry, driving.step_m)),
             _ => None,
         };
@@ -450,14 +456,15 @@ pub fn drive(
             break;
         };
         let avoided = trip.avoided;
+        if closing.is_some() {
+            // The follower has arrived; the approach only brings the rover nearer.
+            trip.outcome = Outcome::Arrived;
+            approach = APPROACH_STEPS;
+            closed_in += 1;
+        }
         let next = match closing {
-            Some((_, run)) => {
-                // The follower has arrived; the approach only brings the rover nearer.
-                trip.outcome = Outcome::Arrived;
-                approach = APPROACH_STEPS;
-                ahead(pose, bearing, run)
-            }
-            None => step(
+            Some((_, Approach::Straight(run))) => ahead(pose, bearing, run),
+            Some((_, Approach::Around)) | None => step(
                 terrain,
                 &mut avoidance,
                 pose,
@@ -490,39 +497,68 @@ struct Sighted {
     ago: usize,
     /// Its detection reached the panorama's foot ([`foot_row`]).
     at_foot: bool,
-    /// Flat-ground range of its detection's contact row then, metres: how far its rock's near
-    /// side was. A rock cut off by the panorama's foot has its contact nearer than the bottom
-    /// row's ground, so its range is then too far.
-    range_m: Option<f64>,
+    /// Its range interval then, from all cues (`Location::ranges`), metres: from the rock's
+    /// near side to the farthest its centre may be. `None` when the cues set no far bound.
+    range: Option<RangeInterval>,
     /// The rover's dead reckoning then (the panorama's frame).
     odometry: Point,
 }
 
 impl Sighted {
-    /// Where the rock's near side is, by dead reckoning (the panorama's frame).
-    fn near_side(&self) -> Option<Point> {
-        let range = self.range_m?;
+    /// Where the rock is, by dead reckoning (the panorama's frame): its last bearing, at the
+    /// middle of its range interval.
+    fn rock(&self) -> Option<Point> {
+        let range = self.range?;
+        let middle = 0.5 * (range.low + range.high);
         let (sin, cos) = self.bearing.sin_cos();
-        Some(self.odometry + Point::new(range * cos, range * sin))
+        Some(self.odometry + Point::new(middle * cos, middle * sin))
+    }
+
+    /// Whether the rover still knows where the landmark is: seen in the last [`MEMORY_STEPS`],
+    /// or in the last [`DEAD_RECKONING_STEPS`] with a bounded range, where dead reckoning
+    /// keeps its place (and [`Sighted::driven_up_to`] ends the drive to it).
+    fn remembered(&self) -> bool {
+        self.ago <= MEMORY_STEPS || self.range.is_some() && self.ago <= DEAD_RECKONING_STEPS
+    }
+
+    /// The bearing to drive to the rock from dead reckoning `odometry`: toward its place
+    /// ([`Sighted::rock`]), which stays right when the hazard avoidance turned the rover
+    /// aside; its last bearing when its range has no far bound.
+    fn bearing_from(&self, odometry: Point) -> f64 {
+        self.rock().map_or(self.bearing, |rock| {
+            let way = rock - odometry;
+            way.y.atan2(way.x)
+        })
     }
 
     /// Whether the rover, at dead reckoning `odometry`, has driven up to the rock: as far on
-    /// its last bearing as its near side less [`CLEARANCE_M`], where the hazard cameras keep
-    /// the rover. Driving on the last bearing any farther passes the rock.
+    /// its last bearing as the nearest its near side may be, less [`CLEARANCE_M`], where the
+    /// hazard cameras keep the rover. Driving on the last bearing any farther passes the rock.
     fn driven_up_to(&self, odometry: Point) -> bool {
-        let (Some(range), (sin, cos)) = (self.range_m, self.bearing.sin_cos()) else {
+        let (Some(range), (sin, cos)) = (self.range, self.bearing.sin_cos()) else {
             return false;
         };
         let driven = odometry - self.odometry;
-        driven.x * cos + driven.y * sin >= range - CLEARANCE_M
+        driven.x * cos + driven.y * sin >= range.low - CLEARANCE_M
     }
 }
 
+/// How the final approach drives its step ([`final_approach`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Approach {
+    /// Straight on the bearing, this many metres.
+    Straight(f64),
+    /// Around a rock in the way that is not the goal's (farther from its place than the
+    /// hazard cameras' stop), as the hazard avoidance drives a step.
+    Around,
+}
+
 /// The final approach's next step once the follower has arrived, from dead reckoning
-/// `odometry`: the bearing of the goal's near side ([`Sighted::near_side`]), and how far to
-/// drive straight on it, up to the near side, up to where the hazard cameras stop the rover
-/// [`CLEARANCE_M`] from a rock ([`clear_run`]), and at most one step. `None` when the rover
-/// can drive no nearer.
+/// `odometry`: the bearing of the goal's rock ([`Sighted::rock`]), and how to drive it.
+/// Straight, up to the rock's estimated place, up to where the hazard cameras stop the rover
+/// [`CLEARANCE_M`] from a rock ([`clear_run`]), and at most one step; around a rock that
+/// stops the rover farther than that from the goal's near side. `None` when the rover can
+/// drive no nearer.
 ///
 /// Why: arriving by range order, or by the goal leaving the view at its foot, leaves the rover
 /// anywhere up to the blind zone's 2.1 m from the goal, where a neighbour under the camera is
@@ -534,8 +570,9 @@ fn final_approach(
     seen: &Sighted,
     odometry: Point,
     step_m: f64,
-) -> Option<(f64, f64)> {
-    let way = seen.near_side()? - odometry;
+) -> Option<(f64, Approach)> {
+    let (rock, range) = (seen.rock()?, seen.range?);
+    let way = rock - odometry;
     let (left, bearing) = (way.x.hypot(way.y), way.y.atan2(way.x));
     if left < MIN_APPROACH_M {
         return None;
@@ -548,7 +585,12 @@ fn final_approach(
         left.min(step_m),
         CLEARANCE_M,
     );
-    (run >= MIN_APPROACH_M).then_some((bearing, run))
+    if run >= MIN_APPROACH_M {
+        return Some((bearing, Approach::Straight(run)));
+    }
+    // Stopped: by the goal's rock, or by another one in front of it.
+    let near_side = left - 0.5 * (range.high - range.low);
+    (near_side > 2.0 * CLEARANCE_M).then_some((bearing, Approach::Around))
 }
 
 /// The point `length` metres from `pose` straight on `bearing` (the panorama's frame).
@@ -725,32 +767,32 @@ mod tests {
         assert!(!left_view(calib.azimuth(2.5), &[straddling], &calib, foot));
     }
 
-    fn sighted(bearing: f64, range_m: Option<f64>, odometry: Point) -> Sighted {
+    fn sighted(bearing: f64, range: Option<(f64, f64)>, odometry: Point) -> Sighted {
         Sighted {
             bearing,
             ago: 1,
             at_foot: true,
-            range_m,
+            range: range.map(|(low, high)| RangeInterval::new(low, high)),
             odometry,
         }
     }
 
     #[test]
     fn a_rock_is_driven_up_to_once_the_rover_is_as_far_on_its_bearing_as_its_near_side() {
-        // Seen 2 m away at 90°, from dead reckoning (1, 0).
-        let seen = sighted(FRAC_PI_2, Some(2.0), Point::new(1.0, 0.0));
-        let near_side = seen.near_side().unwrap();
-        assert!(near_side.distance(Point::new(1.0, 2.0)) < 1e-12);
+        // Seen 2–2.4 m away at 90°, from dead reckoning (1, 0).
+        let seen = sighted(FRAC_PI_2, Some((2.0, 2.4)), Point::new(1.0, 0.0));
+        let rock = seen.rock().unwrap();
+        assert!(rock.distance(Point::new(1.0, 2.2)) < 1e-12);
         let reach = 2.0 - CLEARANCE_M;
         assert!(!seen.driven_up_to(Point::new(1.0, reach - 0.01)));
         assert!(seen.driven_up_to(Point::new(1.0, reach + 0.01)));
         // Passing beside the rock counts: only the way along the bearing does.
         assert!(!seen.driven_up_to(Point::new(3.0, 1.0)));
         assert!(seen.driven_up_to(Point::new(0.2, 2.5)));
-        // A detection with no ground range is never driven up to.
+        // A rock whose cues set no far bound is never driven up to.
         let unranged = sighted(FRAC_PI_2, None, Point::new(1.0, 0.0));
         assert!(!unranged.driven_up_to(Point::new(1.0, 9.0)));
-        assert_eq!(unranged.near_side(), None);
+        assert_eq!(unranged.rock(), None);
     }
 
     #[test]
@@ -763,7 +805,7 @@ mod tests {
             calib: &calib,
             landmark_rocks: &rocks,
         };
-        // The panorama's frame turned a quarter from the world's: bearing 0 looks along +y.
+        // The panorama's frame turned a quarter from the world's: bearing π/2 looks along +x.
         let at = |x: f64| Pose {
             position: Point::new(x, 0.0),
             heading: -FRAC_PI_2,
@@ -771,40 +813,78 @@ mod tests {
         // Dead reckoning after driving `x` along world +x.
         let frame = |x: f64| Point::new(0.0, x);
         let near_side = 3.0 - world.contact_radius(0);
-        // Seen from the start at bearing π/2 (along world +x): a whole step that way.
-        let seen = sighted(FRAC_PI_2, Some(near_side), frame(0.0));
-        let (bearing, run) = final_approach(&terrain, at(0.0), &seen, frame(0.0), 0.5).unwrap();
-        assert!((bearing - FRAC_PI_2).abs() < 1e-12 && run == 0.5);
+        // Seen from the start: a whole step at it.
+        let seen = sighted(FRAC_PI_2, Some((near_side, 3.0)), frame(0.0));
+        let (bearing, how) = final_approach(&terrain, at(0.0), &seen, frame(0.0), 0.5).unwrap();
+        assert!((bearing - FRAC_PI_2).abs() < 1e-12 && how == Approach::Straight(0.5));
         // Near the rock: up to the clearance from its footprint, and no farther.
         let stop = near_side - CLEARANCE_M;
         let near = stop - 0.22;
-        let (_, run) = final_approach(&terrain, at(near), &seen, frame(near), 0.5).unwrap();
-        assert!(run <= 0.22 && run > 0.22 - 0.05, "{run}");
+        let how = final_approach(&terrain, at(near), &seen, frame(near), 0.5)
+            .unwrap()
+            .1;
+        assert!(
+            matches!(how, Approach::Straight(run) if run <= 0.22 && run > 0.22 - 0.05),
+            "{how:?}"
+        );
         assert_eq!(
             final_approach(&terrain, at(stop), &seen, frame(stop), 0.5),
             None
         );
-        // Dead reckoning turns the bearing toward the near side after a detour.
+        // Dead reckoning turns the bearing toward the rock after a detour.
         let aside = Pose {
             position: Point::new(1.0, 1.0),
             heading: -FRAC_PI_2,
         };
         let (bearing, _) =
             final_approach(&terrain, aside, &seen, Point::new(-1.0, 1.0), 0.5).unwrap();
-        let way = Point::new(near_side - 1.0, -1.0);
+        let way = Point::new(0.5 * (near_side + 3.0) - 1.0, -1.0);
         assert!((aside.heading + bearing - way.y.atan2(way.x)).abs() < 1e-12);
-        // A goal seen at 1 m in open ground: the approach ends at its estimated near side.
-        let short = sighted(-FRAC_PI_2, Some(1.0), frame(0.0));
-        let (_, run) = final_approach(&terrain, at(0.0), &short, frame(0.0), 1.5).unwrap();
-        assert!((run - 1.0).abs() < 1e-12, "{run}");
+        // A goal seen 1 m away in open ground: the approach ends where it was estimated.
+        let short = sighted(-FRAC_PI_2, Some((1.0, 1.0)), frame(0.0));
+        let how = final_approach(&terrain, at(0.0), &short, frame(0.0), 1.5)
+            .unwrap()
+            .1;
+        assert!(
+            matches!(how, Approach::Straight(run) if (run - 1.0).abs() < 1e-12),
+            "{how:?}"
+        );
         let there = Point::new(0.0, -1.0);
         assert_eq!(final_approach(&terrain, at(0.0), &short, there, 0.5), None);
-        // Never ranged: no approach.
+        // No far bound: no approach.
         let unranged = sighted(FRAC_PI_2, None, frame(0.0));
         assert_eq!(
             final_approach(&terrain, at(0.0), &unranged, frame(0.0), 0.5),
             None
         );
+    }
+
+    #[test]
+    fn the_final_approach_goes_around_a_rock_in_front_of_the_goal() {
+        let calib = default_calibration();
+        // The goal at x = 5, another rock at x = 2 on the way to it.
+        let placements = [(Point::new(5.0, 0.0), 0.5), (Point::new(2.0, 0.0), 0.5)];
+        let world = World::generate(5, &placements);
+        let rocks = BTreeMap::from([(0, 0), (1, 1)]);
+        let terrain = Terrain {
+            world: &world,
+            calib: &calib,
+            landmark_rocks: &rocks,
+        };
+        let near_side = 5.0 - world.contact_radius(0);
+        let seen = sighted(0.0, Some((near_side, 5.0)), Point::new(0.0, 0.0));
+        let at = |x: f64| Pose {
+            position: Point::new(x, 0.0),
+            heading: 0.0,
+        };
+        let stopped = 2.0 - world.contact_radius(1) - CLEARANCE_M;
+        let (bearing, how) =
+            final_approach(&terrain, at(stopped), &seen, Point::new(stopped, 0.0), 0.5).unwrap();
+        assert_eq!((bearing, how), (0.0, Approach::Around));
+        // Stopped by the goal itself: done.
+        let at_goal = near_side - CLEARANCE_M;
+        let done = final_approach(&terrain, at(at_goal), &seen, Point::new(at_goal, 0.0), 0.5);
+        assert_eq!(done, None);
     }
 
     #[test]

@@ -21,7 +21,7 @@
 
 use crate::association::{associate, AssociationSettings, Decision, Frame, Gallery};
 use crate::calib::Calibration;
-use crate::ranging::{self, SensorModel};
+use crate::ranging::{self, RangeInterval, SensorModel};
 use crate::run::selection::{placement, station_evidence, usable};
 use crate::run::{LandmarkRecord, StationDetections, StationRecord};
 use qrm_core::calculus::Calculus;
@@ -68,6 +68,10 @@ pub struct Location {
     /// their bearings and range order by position in that list.
     #[serde(skip)]
     pub seen: (Vec<LandmarkId>, StationView),
+    /// Every detection's range interval from all cues (`Ranged::fused`), metres, by detection:
+    /// how far its rock is, for a navigator that closes in on it.
+    #[serde(skip)]
+    pub ranges: Vec<RangeInterval>,
 }
 
 impl<C: Calculus> KnownMap<C> {
@@ -176,6 +180,7 @@ impl<C: Calculus> KnownMap<C> {
             seen: (identified.iter().map(|p| p.1).collect(), seen),
             identified,
             ambiguous,
+            ranges: ranged.iter().map(|r| r.fused).collect(),
         }
     }
 }
