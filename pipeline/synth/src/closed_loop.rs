@@ -18,8 +18,9 @@
 //! The follower's cell is that of the nearest *identified* landmark (`navigation::cell_of`
 //! over them; the first of the possible ones when the order cannot tell), as in the
 //! ideal-sensor study. The route is planned from the first panorama's cell. When the next
-//! landmark of the route is not identified in a panorama, the rover drives on its last
-//! bearing if it was seen in the last 6 steps (the rover keeps its heading, so bearings stay
+//! landmark of the route is not identified in a panorama, the rover drives to where it was
+//! last seen: by dead reckoning if it was seen in the last 12 steps with a bounded range, on
+//! its last bearing if in the last 6 steps (the rover keeps its heading, so bearings stay
 //! good); otherwise it re-plans from its cell: the cheapest of the 5 cheapest routes whose
 //! next landmark is in view, or, with none, the cheapest route from a landmark in view (the
 //! rover drives to that landmark first), or, with nothing identified that leads to the goal, a
@@ -84,7 +85,8 @@ const AVOIDED_M: f64 = 0.01;
 const REPLANS: usize = 5;
 /// Routes considered when re-planning.
 const ALTERNATIVES: usize = 5;
-/// Steps for which a landmark's last bearing is driven on while it is not identified.
+/// Steps for which a landmark is driven to while it is not identified, on its last bearing
+/// when its range has no far bound ([`Sighted::remembered`]).
 const MEMORY_STEPS: usize = 6;
 /// Steps for which a landmark's rock is driven to by dead reckoning while it is not
 /// identified, when its range is bounded ([`Sighted::remembered`]).
