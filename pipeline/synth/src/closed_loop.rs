@@ -65,6 +65,7 @@ use image::RgbImage;
 use qrm_core::edc::Edc;
 use qrm_core::geometry::Point;
 use qrm_core::map::LandmarkId;
+use qrm_core::measurement::StationView;
 use qrm_core::navigation::{cell_of, Cell, Command, LegFollower, Route, RouteCost, RouteGraph};
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::Detection;
@@ -391,7 +392,14 @@ pub fn drive(
                     landmark: target,
                     bearing: seen.bearing_from(odometry),
                 },
-                _ => match replan(graph, here, goal, driving.cost, visible, trip.replans) {
+                _ => match replan(
+                    graph,
+                    here,
+                    goal,
+                    driving.cost,
+                    (visible, view),
+                    trip.replans,
+                ) {
                     Some(route) => {
                         trip.replans += 1;
                         let mut next = LegFollower::new(&route);
@@ -637,15 +645,17 @@ fn left_view(bearing: f64, detections: &[Detection], calib: &Calibration, foot_r
 }
 
 /// A route from the rover's cell `here` to `goal` whose first landmark to drive to is in view
-/// (`visible`): the cheapest of the few cheapest routes. With none (the cell is wrong, or its
-/// routes' next landmarks are not identified), the cheapest route from a landmark in view,
-/// which the rover drives to first. None once [`REPLANS`] are used.
+/// (`visible`, seen as `view`): the cheapest of the few cheapest routes. With none (the cell
+/// is wrong, or its routes' next landmarks are not identified), the cheapest route from a
+/// landmark in view that the follower can start on: one that does not begin in the rover's
+/// certain cell with its next landmark out of view, which would lose the trip at once. None
+/// once [`REPLANS`] are used.
 fn replan(
     graph: &RouteGraph,
     here: Option<LandmarkId>,
     goal: LandmarkId,
     cost: RouteCost,
-    visible: &[LandmarkId],
+    (visible, view): (&[LandmarkId], &StationView),
     replans: usize,
 ) -> Option<Route> {
     if replans >= REPLANS {
@@ -665,6 +675,10 @@ fn replan(
         visible
             .iter()
             .filter_map(|&v| graph.plan(v, goal, cost).ok())
+            .filter(|r| {
+                let first = LegFollower::new(r).step(visible, view);
+                !matches!(first, Command::TargetLost(_))
+            })
             .min_by(|a, b| a.cost.total_cmp(&b.cost))
     })
 }
@@ -703,6 +717,7 @@ fn step(
 mod tests {
     use super::*;
     use crate::default_calibration;
+    use qrm_core::measurement::{Bearing, RangeOrder};
     use qrm_core::neighborhood::{RngEdge, RngEstimate};
     use qrm_vision::detection::{Appearance, Separation};
     use std::f64::consts::FRAC_PI_2;
@@ -901,25 +916,59 @@ mod tests {
         };
         let graph = RouteGraph::new(&[0, 1, 2, 3, 4], &rng);
         let cost = RouteCost { lambda: 1.0 };
-        let landmarks = |route: Option<Route>| route.map(|r| r.landmarks);
+        // Landmarks in view, by position; `nearest`: the one the range order shows nearest.
+        let view = |n: usize, nearest: Option<usize>| {
+            let order = match nearest {
+                Some(k) => RangeOrder::from_pairs(
+                    n,
+                    &(0..n)
+                        .filter(|&j| j != k)
+                        .map(|j| (k, j))
+                        .collect::<Vec<_>>(),
+                ),
+                None => Ok(RangeOrder::unordered(n)),
+            };
+            StationView::new(
+                (0..n).map(|i| Bearing::exact(i as f64)).collect(),
+                order.unwrap(),
+            )
+            .unwrap()
+        };
+        let replanned = |here, visible: &[LandmarkId], nearest, replans| {
+            replan(
+                &graph,
+                here,
+                4,
+                cost,
+                (visible, &view(visible.len(), nearest)),
+                replans,
+            )
+            .map(|r| r.landmarks)
+        };
         // The cell's route, its next landmark in view.
         assert_eq!(
-            landmarks(replan(&graph, Some(0), 4, cost, &[1, 3], 0)),
+            replanned(Some(0), &[1, 3], None, 0),
             Some(vec![0, 1, 2, 3, 4])
         );
         // Its next landmark not in view: drive to the landmark in view nearest the goal first.
-        assert_eq!(
-            landmarks(replan(&graph, Some(0), 4, cost, &[2, 3], 0)),
-            Some(vec![3, 4])
-        );
-        assert_eq!(
-            landmarks(replan(&graph, None, 4, cost, &[2], 0)),
-            Some(vec![2, 3, 4])
-        );
-        assert_eq!(landmarks(replan(&graph, Some(0), 4, cost, &[], 0)), None);
-        assert_eq!(
-            landmarks(replan(&graph, Some(0), 4, cost, &[1], REPLANS)),
-            None
-        );
+        assert_eq!(replanned(Some(0), &[2, 3], None, 0), Some(vec![3, 4]));
+        assert_eq!(replanned(None, &[2, 0], None, 0), Some(vec![2, 3, 4]));
+        // Every route in view passes 3, whose cell the rover is certainly in, with 4 out of
+        // view: each would be lost at once.
+        assert_eq!(replanned(None, &[3, 1], Some(0), 0), None);
+        // With a way round 3 (1–5–4), that one.
+        let rng = RngEstimate {
+            edges: [(1, 2), (2, 3), (3, 4), (1, 5), (5, 4)]
+                .iter()
+                .map(|&(a, b)| RngEdge { a, b, cost: 0.0 })
+                .collect(),
+            pruned: 0,
+        };
+        let round = RouteGraph::new(&[1, 2, 3, 4, 5], &rng);
+        let in_three = view(2, Some(0));
+        let route = replan(&round, None, 4, cost, (&[3, 1], &in_three), 0);
+        assert_eq!(route.map(|r| r.landmarks), Some(vec![1, 5, 4]));
+        assert_eq!(replanned(Some(0), &[], None, 0), None);
+        assert_eq!(replanned(Some(0), &[1], None, REPLANS), None);
     }
 }
