@@ -22,8 +22,8 @@
 //! last seen: by dead reckoning if it was seen in the last 12 steps with a bounded range, on
 //! its last bearing if in the last 6 steps (the rover keeps its heading, so bearings stay
 //! good); otherwise it re-plans from its cell: the cheapest of the 5 cheapest routes whose
-//! next landmark is in view, or, with none, the cheapest route from a landmark in view (the
-//! rover drives to that landmark first), or, with nothing identified that leads to the goal, a
+//! next landmark is in view, or, with none, the cheapest route from a landmark in view that
+//! the follower can start on (the rover drives to that landmark first), or, with nothing identified that leads to the goal, a
 //! step on the goal's last bearing if it was ever seen (at most 5 re-plans); else the trip is
 //! lost. When the follower arrives (the goal is the nearest identified landmark) but a
 //! detection not identified may be nearer still, the rover closes in on the goal for up to 8
