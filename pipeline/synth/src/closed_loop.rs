@@ -23,11 +23,12 @@
 //! its last bearing if in the last 6 steps (the rover keeps its heading, so bearings stay
 //! good); otherwise it re-plans from its cell: the cheapest of the 5 cheapest routes whose
 //! next landmark is in view, or, with none, the cheapest route from a landmark in view that
-//! the follower can start on (the rover drives to that landmark first), or, with nothing identified that leads to the goal, a
-//! step on the goal's last bearing if it was ever seen (at most 5 re-plans); else the trip is
-//! lost. When the follower arrives (the goal is the nearest identified landmark) but a
-//! detection not identified may be nearer still, the rover closes in on the goal for up to 8
-//! more steps until the panorama proves it the nearest of all.
+//! the follower can start on (the rover drives to that landmark first), or, with nothing
+//! identified that leads to the goal, a step on the goal's last bearing if it was ever seen
+//! (at most 5 re-plans); else the trip is lost. When the follower arrives (the goal is the
+//! nearest identified landmark) but a detection not identified may be nearer still, the rover
+//! closes in on the goal for up to 8 more steps until the panorama proves it the nearest of
+//! all.
 //!
 //! The camera cannot see the ground near the rover: below the panorama's bottom row lies a
 //! blind zone (2.1 m of flat ground from a 1.5 m mast at marsyard's calibration). A rock the
@@ -647,9 +648,9 @@ fn left_view(bearing: f64, detections: &[Detection], calib: &Calibration, foot_r
 /// A route from the rover's cell `here` to `goal` whose first landmark to drive to is in view
 /// (`visible`, seen as `view`): the cheapest of the few cheapest routes. With none (the cell
 /// is wrong, or its routes' next landmarks are not identified), the cheapest route from a
-/// landmark in view that the follower can start on: one that does not begin in the rover's
-/// certain cell with its next landmark out of view, which would lose the trip at once. None
-/// once [`REPLANS`] are used.
+/// landmark in view that the follower can start on: its first target in view (a route through
+/// the rover's certain cell whose next landmark is out of view would lose the trip at once).
+/// None once [`REPLANS`] are used.
 fn replan(
     graph: &RouteGraph,
     here: Option<LandmarkId>,
