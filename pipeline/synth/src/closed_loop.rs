@@ -58,7 +58,7 @@
 //! Voronoi cell (the landmark whose rock is nearest to it).
 
 use crate::clearance_grid::grown_footprints;
-use crate::hazard_avoidance::{clear_run, HazardAvoidance};
+use crate::hazard_avoidance::{clear_run, toward, HazardAvoidance};
 use crate::reference_path::shortest_path_m;
 use crate::render::{render, Eye, Pose};
 use crate::world::World;
@@ -429,6 +429,7 @@ pub fn drive(
         if command == Command::Arrived
             && location.whereabouts != (Whereabouts::Certain { landmark: goal })
             && approach < APPROACH_STEPS
+            && closed_in == 0
         {
             if let Some(seen) = last_seen
                 .get(&goal)
@@ -470,11 +471,12 @@ pub fn drive(
         if closing.is_some() {
             // The follower has arrived; the approach only brings the rover nearer.
             trip.outcome = Outcome::Arrived;
-            approach = APPROACH_STEPS;
             closed_in += 1;
         }
         let next = match closing {
-            Some((_, Approach::Straight(run))) => ahead(pose, bearing, run),
+            Some((_, Approach::Straight(run))) => {
+                toward(pose.position, pose.heading + bearing, run)
+            }
             Some((_, Approach::Around)) | None => step(
                 terrain,
                 &mut avoidance,
@@ -536,10 +538,13 @@ impl Sighted {
     /// ([`Sighted::rock`]), which stays right when the hazard avoidance turned the rover
     /// aside; its last bearing when its range has no far bound.
     fn bearing_from(&self, odometry: Point) -> f64 {
-        self.rock().map_or(self.bearing, |rock| {
-            let way = rock - odometry;
-            way.y.atan2(way.x)
-        })
+        self.way_from(odometry)
+            .map_or(self.bearing, |way| way.y.atan2(way.x))
+    }
+
+    /// The way from dead reckoning `odometry` to the rock's place ([`Sighted::rock`]).
+    fn way_from(&self, odometry: Point) -> Option<Point> {
+        Some(self.rock()? - odometry)
     }
 
     /// Whether the rover, at dead reckoning `odometry`, has driven up to the rock: as far on
@@ -582,8 +587,7 @@ fn final_approach(
     odometry: Point,
     step_m: f64,
 ) -> Option<(f64, Approach)> {
-    let (rock, range) = (seen.rock()?, seen.range?);
-    let way = rock - odometry;
+    let (way, range) = (seen.way_from(odometry)?, seen.range?);
     let (left, bearing) = (way.x.hypot(way.y), way.y.atan2(way.x));
     if left < MIN_APPROACH_M {
         return None;
@@ -602,15 +606,6 @@ fn final_approach(
     // Stopped: by the goal's rock, or by another one in front of it.
     let near_side = left - 0.5 * (range.high - range.low);
     (near_side > 2.0 * CLEARANCE_M).then_some((bearing, Approach::Around))
-}
-
-/// The point `length` metres from `pose` straight on `bearing` (the panorama's frame).
-fn ahead(pose: Pose, bearing: f64, length: f64) -> Point {
-    let azimuth = pose.heading + bearing;
-    Point::new(
-        pose.position.x + length * azimuth.cos(),
-        pose.position.y + length * azimuth.sin(),
-    )
 }
 
 /// The first row of the panorama's foot: below it lies flat ground within one step of the
@@ -694,16 +689,10 @@ fn step(
     length: f64,
     trip: &mut Trip,
 ) -> Point {
-    let from = pose.position;
-    let straight = ahead(pose, bearing, length);
+    let (from, azimuth) = (pose.position, pose.heading + bearing);
+    let straight = toward(from, azimuth, length);
     let next = avoidance
-        .drive(
-            terrain.world,
-            from,
-            pose.heading + bearing,
-            length,
-            CLEARANCE_M,
-        )
+        .drive(terrain.world, from, azimuth, length, CLEARANCE_M)
         .unwrap_or(from);
     if next.distance(straight) > AVOIDED_M {
         trip.avoided += 1;

@@ -71,7 +71,6 @@ impl HazardAvoidance {
         let near: Vec<(Point, f64)> = grown_footprints(world, clearance)
             .filter(|&(p, grown)| p.distance(from) < SIGHT_M * std::f64::consts::SQRT_2 + grown)
             .collect();
-        let toward = |a: f64, d: f64| Point::new(from.x + d * a.cos(), from.y + d * a.sin());
         let detour = std::mem::take(&mut self.detour);
         if !detour.is_empty()
             && angular_distance(azimuth, self.azimuth) < DETOUR_TURN_DEG.to_radians()
@@ -85,12 +84,12 @@ impl HazardAvoidance {
         }
         if let Some(next) = TURNS_DEG
             .iter()
-            .map(|t| toward(azimuth + t.to_radians(), length))
+            .map(|t| toward(from, azimuth + t.to_radians(), length))
             .find(|&p| outside(&near, p))
         {
             return Some(next);
         }
-        let way = around(&near, from, toward(azimuth, LOOKAHEAD_M))?;
+        let way = around(&near, from, toward(from, azimuth, LOOKAHEAD_M))?;
         let (next, rest) = along(&way, length);
         self.detour = rest;
         self.azimuth = azimuth;
@@ -106,13 +105,20 @@ pub fn clear_run(world: &World, from: Point, azimuth: f64, length: f64, clearanc
     let near: Vec<(Point, f64)> = grown_footprints(world, clearance)
         .filter(|&(p, grown)| p.distance(from) < length + grown)
         .collect();
-    let at = |d: f64| Point::new(from.x + d * azimuth.cos(), from.y + d * azimuth.sin());
     let samples = (length / SAMPLE_M).ceil() as usize;
     (1..=samples)
         .map(|k| (k as f64 * SAMPLE_M).min(length))
-        .take_while(|&d| outside(&near, at(d)))
+        .take_while(|&d| outside(&near, toward(from, azimuth, d)))
         .last()
         .unwrap_or(0.0)
+}
+
+/// The point `length` metres from `from` toward `azimuth` (world frame, radians).
+pub(crate) fn toward(from: Point, azimuth: f64, length: f64) -> Point {
+    Point::new(
+        from.x + length * azimuth.cos(),
+        from.y + length * azimuth.sin(),
+    )
 }
 
 /// The shortest clear path from `from` toward `subgoal` (see the module's step 4), starting at
