@@ -320,7 +320,7 @@ fn registrations<'f>(
     placed: &[Option<Placed>],
     candidates: &[Vec<(LandmarkId, f64)>],
     seen: &[Ray],
-    lately: &dyn Fn(LandmarkId) -> bool,
+    lately: &(dyn Fn(LandmarkId) -> bool + Sync),
 ) -> Vec<(&'f Frame, Registration)> {
     let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
     // How far this station places rocks: a landmark the motion brings farther may be beyond
@@ -330,8 +330,10 @@ fn registrations<'f>(
         .flatten()
         .map(|p| p.point[0].hypot(p.point[1]))
         .fold(0.0, f64::max);
+    // Frames in parallel: a navigator registers its panorama against every station of the
+    // run (marsyard: 50 frames, 70 ms of a step's compute on one core).
     frames
-        .iter()
+        .par_iter()
         .filter_map(|frame| {
             // Registration hypotheses grow with the square of the seeds: each detection seeds
             // only with its closest few look-alikes (the lists are sorted by descriptor
@@ -616,42 +618,49 @@ fn triple_consistency<C: Calculus>(
     Some(measured.iter().all(|r| !r.is_empty()))
 }
 
-/// Drops anchors until every triple of anchors the map knows is consistent.
+/// Drops anchors until every triple of anchors the map knows is consistent: the anchor in
+/// most inconsistent triples first, the weaker appearance match on ties. A triple's verdict
+/// does not depend on the other anchors, so each triple is measured once, in parallel (a
+/// navigator's panorama anchors a dozen landmarks: some 200 triples).
 fn drop_inconsistent_anchors<C: Calculus>(
     map: &Hypergraph<C>,
     view: &StationView,
     anchors: &mut Vec<(usize, LandmarkId, f64)>,
 ) {
+    let k = anchors.len();
+    let triples: Vec<[usize; 3]> = (0..k)
+        .flat_map(|x| (x + 1..k).flat_map(move |y| (y + 1..k).map(move |z| [x, y, z])))
+        .collect();
+    let inconsistent: Vec<[usize; 3]> = triples
+        .into_par_iter()
+        .filter(|t| {
+            let (detections, ids) = (t.map(|i| anchors[i].0), t.map(|i| anchors[i].1));
+            triple_consistency(map, view, detections, ids) == Some(false)
+        })
+        .collect();
+    let mut kept = vec![true; k];
     loop {
-        let k = anchors.len();
         let mut failures = vec![0usize; k];
-        for x in 0..k {
-            for y in x + 1..k {
-                for z in y + 1..k {
-                    let (p, q, r) = (anchors[x], anchors[y], anchors[z]);
-                    if triple_consistency(map, view, [p.0, q.0, r.0], [p.1, q.1, r.1])
-                        == Some(false)
-                    {
-                        failures[x] += 1;
-                        failures[y] += 1;
-                        failures[z] += 1;
-                    }
-                }
+        for triple in inconsistent.iter().filter(|t| t.iter().all(|&i| kept[i])) {
+            for &i in triple {
+                failures[i] += 1;
             }
         }
-        // The worst offender, the weaker appearance match on ties.
         let worst = (0..k).filter(|&i| failures[i] > 0).max_by(|&i, &j| {
             failures[i]
                 .cmp(&failures[j])
                 .then(anchors[i].2.total_cmp(&anchors[j].2))
         });
         match worst {
-            Some(i) => {
-                anchors.remove(i);
-            }
-            None => return,
+            Some(i) => kept[i] = false,
+            None => break,
         }
     }
+    *anchors = anchors
+        .iter()
+        .zip(&kept)
+        .filter_map(|(anchor, &kept)| kept.then_some(*anchor))
+        .collect();
 }
 
 /// 000 §VI-C for one detection: the candidates the map does not reject.

@@ -14,8 +14,7 @@
 //! this test carry that many rows of doubt on their contact ([`contact_of`]).
 
 use crate::calib::Calibration;
-use kornia_image::{Image, ImageSize};
-use kornia_imgproc::filter::gaussian_blur;
+use kornia_imgproc::filter::kernels::gaussian_kernel_1d;
 use rayon::prelude::*;
 
 /// Half-size of the matching window, pixels.
@@ -150,34 +149,44 @@ const SMOOTHING_PX: f32 = 1.0;
 /// weight.
 const SMOOTHING_REACH: usize = 2 * SMOOTHING_PX as usize;
 
-/// `band` (rows of `width`) smoothed by a Gaussian of [`SMOOTHING_PX`], wrapping at the seam.
+/// `band` (rows of `width`) smoothed by kornia's Gaussian kernel of [`SMOOTHING_PX`], wrapping
+/// at the seam and taking rows beyond the band as zero, as kornia's `gaussian_blur` would: the
+/// same sums in the same order. Written as two passes over whole rows, rows in parallel, which
+/// compile to vector instructions: kornia 0.2's separable filter tests every tap's bounds on
+/// one thread, 22 ms a band at 4096 × 768, half the stereo test's time in a navigator's step.
 fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
+    let kernel = gaussian_kernel_1d(2 * SMOOTHING_REACH + 1, SMOOTHING_PX);
     let pad = SMOOTHING_REACH;
     let rows = band.len() / width;
-    let padded_width = width + 2 * pad;
-    let mut padded: Vec<f32> = Vec::with_capacity(padded_width * rows);
-    for row in band.chunks_exact(width) {
-        let wrapped = |k: usize| f32::from(row[k % width]);
-        padded.extend((0..pad).map(|k| wrapped(k + pad * width - pad)));
-        padded.extend(row.iter().map(|&v| f32::from(v)));
-        padded.extend((0..pad).map(wrapped));
-    }
-    let size = ImageSize {
-        width: padded_width,
-        height: rows,
-    };
-    let blurred = Image::<f32, 1>::new(size, padded)
-        .and_then(|src| {
-            let mut dst = Image::<f32, 1>::from_size_val(size, 0.0)?;
-            let taps = 2 * SMOOTHING_REACH + 1;
-            gaussian_blur(&src, &mut dst, (taps, taps), (SMOOTHING_PX, SMOOTHING_PX))?;
-            Ok(dst)
-        })
-        .expect("a non-empty band and a positive sigma");
-    let mut out = Vec::with_capacity(width * rows);
-    for row in blurred.as_slice().chunks_exact(padded_width) {
-        out.extend_from_slice(&row[pad..pad + width]);
-    }
+    let mut across = vec![0f32; band.len()];
+    across
+        .par_chunks_mut(width)
+        .zip(band.par_chunks(width))
+        .for_each(|(out, row)| {
+            let wrapped = |k: usize| f32::from(row[k % width]);
+            let padded: Vec<f32> = (0..width + 2 * pad)
+                .map(|k| wrapped(k + pad * width - pad))
+                .collect();
+            for (k, &weight) in kernel.iter().enumerate() {
+                for (o, &v) in out.iter_mut().zip(&padded[k..k + width]) {
+                    *o += v * weight;
+                }
+            }
+        });
+    let mut out = vec![0f32; band.len()];
+    out.par_chunks_mut(width).enumerate().for_each(|(y, out)| {
+        for (k, &weight) in kernel.iter().enumerate() {
+            let Some(from) = (y + k).checked_sub(pad).filter(|&r| r < rows) else {
+                continue;
+            };
+            for (o, &v) in out
+                .iter_mut()
+                .zip(&across[from * width..(from + 1) * width])
+            {
+                *o += v * weight;
+            }
+        }
+    });
     out
 }
 
@@ -347,6 +356,56 @@ mod tests {
     }
 
     /// A band thinner and narrower than the smoothing kernel and the window is still judged.
+    /// kornia's `gaussian_blur` of the band padded by wrapping at the seam: the reference
+    /// [`smoothed`] must equal bit for bit.
+    fn smoothed_by_kornia(band: &[u16], width: usize) -> Vec<f32> {
+        use kornia_image::{Image, ImageSize};
+        let pad = SMOOTHING_REACH;
+        let padded_width = width + 2 * pad;
+        let padded: Vec<f32> = band
+            .chunks_exact(width)
+            .flat_map(|row| {
+                (0..padded_width).map(move |k| f32::from(row[(k + pad * width - pad) % width]))
+            })
+            .collect();
+        let size = ImageSize {
+            width: padded_width,
+            height: band.len() / width,
+        };
+        let src = Image::<f32, 1>::new(size, padded).expect("sized");
+        let mut dst = Image::<f32, 1>::from_size_val(size, 0.0).expect("sized");
+        let taps = 2 * SMOOTHING_REACH + 1;
+        kornia_imgproc::filter::gaussian_blur(
+            &src,
+            &mut dst,
+            (taps, taps),
+            (SMOOTHING_PX, SMOOTHING_PX),
+        )
+        .expect("a valid kernel");
+        dst.as_slice()
+            .chunks_exact(padded_width)
+            .flat_map(|row| row[pad..pad + width].to_vec())
+            .collect()
+    }
+
+    #[test]
+    fn the_smoothing_is_kornias_gaussian_blur_wrapped_at_the_seam() {
+        for (width, rows) in [(61, 23), (7, 3), (3, 1), (1, 4)] {
+            let band: Vec<u16> = (0..width * rows)
+                .map(|i| ((i * 7919 + i * i * 31) % 766) as u16)
+                .collect();
+            let ours = smoothed(&band, width);
+            let theirs = smoothed_by_kornia(&band, width);
+            assert!(
+                ours.iter()
+                    .zip(&theirs)
+                    .all(|(a, b)| a.to_bits() == b.to_bits()),
+                "{width} x {rows}"
+            );
+            assert_eq!(ours.len(), theirs.len());
+        }
+    }
+
     #[test]
     fn a_tiny_band_is_judged_without_panic() {
         let calib = calib();
