@@ -50,7 +50,9 @@
 //! by dead reckoning, until the hazard cameras stop it [`CLEARANCE_M`] from a rock. The
 //! goal's cell is convex and holds the goal, so this never leaves the cell once in it. The
 //! hazard cameras (as [`HazardAvoidance`]) only say how far the way ahead is clear, never
-//! where to go.
+//! where to go. Stopped there, the rover may stand where the goal's cell meets a neighbour's;
+//! when dead reckoning puts another remembered landmark about as near as the goal, it rounds
+//! the goal to its far side ([`far_side`]).
 //!
 //! The rover keeps its heading (a holonomic rover, or one that turns back after each step):
 //! bearings are in the panorama's frame, and the step is taken in that frame. Success is
