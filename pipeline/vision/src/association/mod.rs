@@ -51,7 +51,7 @@ pub use gallery::{distance, AppearanceScales, Gallery, Profile};
 pub use placement::Placed;
 pub use recency::LastSeen;
 pub use registration::{displacement, register, Frame, Registration};
-use registration::{ANCHOR_RADIUS_M, MIN_INLIERS, SIGNIFICANT_NFA};
+use registration::{ANCHOR_RADIUS_M, LONG_ANCHOR_RADIUS_M, MIN_INLIERS, SIGNIFICANT_NFA};
 pub use sketch::Sketch;
 
 use crate::detection::Appearance;
@@ -178,16 +178,32 @@ pub enum Decision {
     Matched(LandmarkId),
     New,
     HeldBack(Vec<LandmarkId>),
-    /// A piece ([`Evidence::piece`]) that matched no landmark: not made a landmark of its own.
+    /// A detection that matched no landmark and founds none ([`founds_landmark`]).
     Withheld,
 }
 
-/// A new landmark for the detection with `evidence`, unless it is a piece.
+/// Whether a detection that matched no landmark founds one of its own. A piece
+/// ([`Evidence::piece`]) does not: it may be part of a rock or hold parts of two. Nor does a
+/// detection placed looser than any registration pairs ([`LONG_ANCHOR_RADIUS_M`], a far rock
+/// whose range interval spans metres): its landmark would stay as loose in every frame, so no
+/// later sighting could be paired with it, while every look-alike seen along its ray would
+/// take it for a candidate and be held back (half-resolution marsyard seed 4: a rock 11 m
+/// away founded a landmark placed within 7 m either way, for which 36 later sightings of it
+/// and of another rock were held back and given up; without it, the rock founded a landmark
+/// from 3.8 m, matched at 7 later stations).
+pub fn founds_landmark(evidence: &Evidence) -> bool {
+    !evidence.piece
+        && evidence
+            .placed
+            .is_some_and(|p| p.reach() <= LONG_ANCHOR_RADIUS_M)
+}
+
+/// A new landmark for the detection with `evidence`, unless it founds none.
 fn founded(evidence: &Evidence) -> Decision {
-    if evidence.piece {
-        Decision::Withheld
-    } else {
+    if founds_landmark(evidence) {
         Decision::New
+    } else {
+        Decision::Withheld
     }
 }
 
@@ -837,6 +853,27 @@ mod tests {
     fn a_piece_founds_no_landmark() {
         let (_, mut station) = station(&[[5.0, 0.0], [0.0, 6.0], [-4.0, -3.0]]);
         station.detections[1].piece = true;
+        let decisions = associate_station(&(Gallery::default(), station), &[]);
+        assert_eq!(
+            decisions,
+            [Decision::New, Decision::Withheld, Decision::New]
+        );
+    }
+
+    /// A far detection whose range interval spans metres founds no landmark: no registration
+    /// could pair a later sighting with one placed so loosely. One placed as loosely as a
+    /// registration still pairs founds one.
+    #[test]
+    fn a_detection_placed_looser_than_any_registration_pairs_founds_no_landmark() {
+        let (_, mut station) = station(&[[5.0, 0.0], [0.0, 12.0], [-9.0, 0.0]]);
+        let angle = std::f64::consts::FRAC_PI_2;
+        station.detections[1].placed = Some(Placed::along([0.0, 12.0], angle, 6.0, 0.2));
+        station.detections[2].placed = Some(Placed::along(
+            [-9.0, 0.0],
+            std::f64::consts::PI,
+            LONG_ANCHOR_RADIUS_M,
+            0.2,
+        ));
         let decisions = associate_station(&(Gallery::default(), station), &[]);
         assert_eq!(
             decisions,

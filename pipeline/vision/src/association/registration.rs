@@ -79,7 +79,7 @@ pub(super) const ANCHOR_RADIUS_M: f64 = 2.0;
 /// terms of a pair looser than [`ANCHOR_RADIUS_M`] let the far rocks of sparse fields be
 /// re-identified (`sparse-large` seed 3, half resolution: 78.8 % of the correct detections
 /// fused instead of 41.7 %).
-const LONG_ANCHOR_RADIUS_M: f64 = 4.0;
+pub(super) const LONG_ANCHOR_RADIUS_M: f64 = 4.0;
 /// Bearing tolerance, beyond a landmark's placement, within which a detection may be it.
 const UNSEEN_WINDOW_RAD: f64 = 0.05;
 /// Gauss–Newton steps of [`Motion::fit`] at most, and the step (radians and metres) below

@@ -8,8 +8,8 @@ use super::record::{
 use super::selection;
 use crate::association::audit::{regroup, Regrouping};
 use crate::association::{
-    agreement, associate, reconsider, sketch, AssociationSettings, Decision, Evidence, Frame,
-    Gallery, LastSeen, Placed, Profile, Sketch, StationEvidence,
+    agreement, associate, founds_landmark, reconsider, sketch, AssociationSettings, Decision,
+    Evidence, Frame, Gallery, LastSeen, Placed, Profile, Sketch, StationEvidence,
 };
 use crate::calib::Calibration;
 use crate::detection::{Detection, Separation};
@@ -226,8 +226,13 @@ impl<C: Calculus> Mapper<C> {
         let start = Instant::now();
         for (position, decision) in decisions.iter().enumerate() {
             if *decision == Decision::Withheld {
+                let reason = if evidence.detections[position].piece {
+                    Exclusion::Touching
+                } else {
+                    Exclusion::Loose
+                };
                 record.detections[usable[position]].association = Association::Unused {
-                    reason: Some(Exclusion::Touching),
+                    reason: Some(reason),
                 };
             }
         }
@@ -588,9 +593,9 @@ impl<C: Calculus> Mapper<C> {
                     pending[k].candidates = candidates;
                     continue;
                 }
-                // Every candidate rejected: a rock the map did not have, unless a piece,
-                // which founds no landmark (`association::Decision::Withheld`).
-                Some(_) if item.evidence.piece => {
+                // Every candidate rejected: a rock the map did not have, unless the detection
+                // founds no landmark (a piece, or one placed too loosely).
+                Some(_) if !founds_landmark(&item.evidence) => {
                     done[k] = true;
                     self.expired += 1;
                     continue;

@@ -112,6 +112,9 @@ pub enum Exclusion {
     /// The detector doubts it is one whole rock: a piece cut at a shallow notch, a top
     /// without its body, or no stereo to tell it from a shadow.
     Doubted,
+    /// Matched no landmark and placed too loosely to found one (a far rock whose range
+    /// interval spans metres: `association::founds_landmark`).
+    Loose,
     /// Narrower than a 512th of the view: mostly pieces of larger rocks.
     Sliver,
     /// Taller than wide: a farther rock seen over a nearer one.
