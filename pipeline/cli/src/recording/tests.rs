@@ -339,6 +339,79 @@ fn mcap_has_every_channel_once_per_station_matching_its_schema() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A trip of `steps` logged steps toward `goal`, every optional field set on odd steps only.
+fn trip(goal: u32, steps: usize) -> qrm_synth::closed_loop::Trip {
+    use qrm_synth::closed_loop::{Outcome, StepLog, Trip};
+    let commands = ["toward", "closing_in", "arrived", "lost"];
+    Trip {
+        start: [1.0, -2.0],
+        goal,
+        outcome: Outcome::Arrived,
+        route: vec![3, goal],
+        replans: 1,
+        path: (0..=steps).map(|k| [k as f64 * 0.5, -2.0]).collect(),
+        collisions: 0,
+        avoided: 1,
+        navigator_seconds: vec![0.1; steps],
+        in_goal_cell: true,
+        length_m: steps as f64 * 0.5,
+        straight_m: 3.0,
+        reference_m: None,
+        steps: (0..steps)
+            .map(|k| StepLog {
+                step: k,
+                position: [k as f64 * 0.5, -2.0],
+                heading_deg: -90.0 + k as f64,
+                identified: (0..k as u32).collect(),
+                detections: 2 * k,
+                cell: (k % 2 == 1).then_some(3),
+                command: commands[k % commands.len()],
+                target: (k % 2 == 1).then_some(goal),
+                bearing_deg: (k % 2 == 1).then_some(12.5),
+                replans: k / 2,
+                avoided: k == 1,
+                navigator_seconds: 0.1,
+                detect_seconds: 0.05,
+            })
+            .collect(),
+    }
+}
+
+/// drive.mcap: one message per step of every trip, in order, one second apart, each matching
+/// the schema the file carries (no field missing and none it does not describe).
+#[test]
+fn drive_log_has_one_message_per_step_matching_its_schema() {
+    let dir = scratch("drive");
+    let path = dir.path().join("drive.mcap");
+    let trips = [trip(7, 5), trip(9, 3)];
+    navigation_log::write_drive_log(&path, &trips).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let mut seen = Vec::new();
+    for (sequence, message) in ::mcap::MessageStream::new(&bytes).unwrap().enumerate() {
+        let message = message.unwrap();
+        let channel = &message.channel;
+        assert_eq!(channel.topic, navigation_log::TOPIC);
+        assert_eq!(channel.message_encoding, "json");
+        let schema = channel.schema.as_ref().unwrap();
+        assert_eq!(schema.encoding, "jsonschema");
+        let schema: Value = serde_json::from_slice(&schema.data).unwrap();
+        let value: Value = serde_json::from_slice(&message.data).unwrap();
+        check(&value, &schema, &schema, &channel.topic);
+        assert_eq!(message.log_time, sequence as u64 * 1_000_000_000);
+        seen.push((
+            value["trip"].as_u64().unwrap(),
+            value["goal"].as_u64().unwrap(),
+            value["step"].as_u64().unwrap(),
+        ));
+    }
+    let expected: Vec<(u64, u64, u64)> = (0..5)
+        .map(|k| (0, 7, k))
+        .chain((0..3).map(|k| (1, 9, k)))
+        .collect();
+    assert_eq!(seen, expected);
+    std::fs::remove_dir_all(dir.path()).ok();
+}
+
 #[test]
 fn recording_errors_name_the_target() {
     let path = Path::new("/nonexistent-qrm-dir/run.mcap");
