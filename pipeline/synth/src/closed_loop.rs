@@ -235,17 +235,23 @@ impl Terrain<'_> {
     /// The shortest clear path from `start` into `goal`'s true cell (judging only).
     fn reference(&self, start: Point, goal: LandmarkId) -> Option<f64> {
         shortest_path_m(self.world, start, CLEARANCE_M, |p| {
-            self.true_cell(p) == Some(goal)
+            self.in_true_cell(p, goal)
         })
     }
 
-    /// The map landmark whose rock is nearest to `p`.
-    fn true_cell(&self, p: Point) -> Option<LandmarkId> {
-        self.landmark_rocks
-            .iter()
-            .map(|(&l, &r)| (l, self.world.rocks[r as usize].position.distance(p)))
+    /// Whether `p` lies in landmark `l`'s true cell: `l`'s rock is the nearest to `p` of the
+    /// map's landmarks' rocks. Two landmarks of one rock (a rock the map duplicated) share its
+    /// cell: judged by landmark, a rover at the rock was outside the cell of whichever of them
+    /// lost the tie (half-resolution marsyard seed 4: 6 trips to a duplicate landmark judged
+    /// beside their goal cell while at its rock).
+    fn in_true_cell(&self, p: Point, l: LandmarkId) -> bool {
+        let nearest = self
+            .landmark_rocks
+            .values()
+            .map(|&r| (r, self.world.rocks[r as usize].position.distance(p)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(l, _)| l)
+            .map(|(r, _)| r);
+        nearest.is_some() && nearest == self.landmark_rocks.get(&l).copied()
     }
 }
 
@@ -512,7 +518,7 @@ pub fn drive(
         pose.position = next;
         trip.path.push([next.x, next.y]);
     }
-    trip.in_goal_cell = terrain.true_cell(pose.position) == Some(goal);
+    trip.in_goal_cell = terrain.in_true_cell(pose.position, goal);
     trip.reference_m = terrain.reference(start.position, goal);
     trip
 }
@@ -940,6 +946,31 @@ mod tests {
         assert_eq!(
             final_approach(&terrain, at(0.0), &unranged, frame(0.0), 0.5),
             None
+        );
+    }
+
+    #[test]
+    fn two_landmarks_of_one_rock_share_its_true_cell() {
+        let calib = default_calibration();
+        let placements = [(Point::new(5.0, 0.0), 0.5), (Point::new(0.0, 0.0), 0.5)];
+        let world = World::generate(5, &placements);
+        // Landmarks 0 and 2 both stand for rock 0 (a rock the map duplicated).
+        let rocks = BTreeMap::from([(0, 0), (1, 1), (2, 0)]);
+        let terrain = Terrain {
+            world: &world,
+            calib: &calib,
+            landmark_rocks: &rocks,
+        };
+        let by_the_first = Point::new(4.0, 0.0);
+        assert!(terrain.in_true_cell(by_the_first, 0));
+        assert!(terrain.in_true_cell(by_the_first, 2));
+        assert!(!terrain.in_true_cell(by_the_first, 1));
+        let by_the_second = Point::new(1.0, 0.0);
+        assert!(terrain.in_true_cell(by_the_second, 1));
+        assert!(!terrain.in_true_cell(by_the_second, 2));
+        assert!(
+            !terrain.in_true_cell(by_the_second, 7),
+            "a landmark the map lacks"
         );
     }
 

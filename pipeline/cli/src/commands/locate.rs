@@ -52,7 +52,8 @@ struct Answer {
     image: String,
     #[serde(flatten)]
     location: Location,
-    /// With `--truth`: the landmark whose rock is nearest to where the panorama was taken.
+    /// With `--truth`: the landmark whose rock is nearest to where the panorama was taken (of
+    /// two landmarks the map made of that rock, the first; either is right).
     #[serde(skip_serializing_if = "Option::is_none")]
     true_cell: Option<LandmarkId>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -115,14 +116,11 @@ pub fn locate(args: &LocateArgs) -> Result<()> {
         };
         let location = known.locate(&detections, &calib, &settings.sensor, &settings.association);
         let image = station.primary.display().to_string();
-        let true_cell = scoring
+        let true_cells = scoring.as_ref().map(|s| s.true_cells(&image)).transpose()?;
+        let true_cell = true_cells.as_ref().and_then(|c| c.first().copied());
+        let verdict = true_cells
             .as_ref()
-            .map(|s| s.true_cell(&image))
-            .transpose()?
-            .flatten();
-        let verdict = scoring
-            .as_ref()
-            .map(|_| verdict(&location.whereabouts, true_cell));
+            .map(|cells| verdict(&location.whereabouts, cells));
         println!("{}", describe(&station.name, &location, true_cell, verdict));
         answers.push(Answer {
             image,
@@ -280,9 +278,10 @@ impl Scoring {
         Ok(Scoring { truth, rocks })
     }
 
-    /// The landmark whose rock is nearest to where `image` was taken (`None` when the map has
-    /// no landmark with a rock).
-    fn true_cell(&self, image: &str) -> Result<Option<LandmarkId>> {
+    /// The landmarks whose rock is nearest to where `image` was taken, ascending: one, or
+    /// several where the map made several landmarks of that rock (none when the map has no
+    /// landmark with a rock).
+    fn true_cells(&self, image: &str) -> Result<Vec<LandmarkId>> {
         let file = Path::new(image)
             .file_name()
             .map(|f| f.to_string_lossy().to_string())
@@ -298,11 +297,16 @@ impl Scoring {
         };
         let at = station.position;
         let distance = |p: &[f64; 2]| (p[0] - at[0]).hypot(p[1] - at[1]);
+        let nearest = self
+            .rocks
+            .values()
+            .min_by(|a, b| distance(a).total_cmp(&distance(b)));
         Ok(self
             .rocks
             .iter()
-            .min_by(|a, b| distance(a.1).total_cmp(&distance(b.1)))
-            .map(|(&l, _)| l))
+            .filter(|(_, p)| Some(*p) == nearest)
+            .map(|(&l, _)| l)
+            .collect())
     }
 }
 
@@ -316,15 +320,17 @@ impl Verdict {
     }
 }
 
-fn verdict(whereabouts: &Whereabouts, truth: Option<LandmarkId>) -> Verdict {
+/// How the located cell compares with the truth: `truth`, the landmarks of the rock nearest to
+/// where the panorama was taken ([`Scoring::true_cells`]).
+fn verdict(whereabouts: &Whereabouts, truth: &[LandmarkId]) -> Verdict {
     match whereabouts {
-        Whereabouts::Certain { landmark } if Some(*landmark) == truth => Verdict::CertainRight,
+        Whereabouts::Certain { landmark } if truth.contains(landmark) => Verdict::CertainRight,
         Whereabouts::Certain { .. } => Verdict::CertainWrong,
         Whereabouts::Possible {
             landmarks,
             unidentified,
         } => {
-            if truth.is_some_and(|t| landmarks.contains(&t)) {
+            if truth.iter().any(|t| landmarks.contains(t)) {
                 Verdict::PossibleHolds
             } else if *unidentified > 0 {
                 Verdict::PossibleUnidentified
@@ -368,4 +374,37 @@ fn describe(
         location.detections,
         location.ambiguous.len()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A map that made two landmarks (5 and 31) of the rock nearest the rover: naming either is
+    /// right.
+    #[test]
+    fn either_landmark_of_a_duplicated_rock_is_the_true_cell() {
+        let truth = [5, 31];
+        let certain = |landmark| Whereabouts::Certain { landmark };
+        assert_eq!(verdict(&certain(31), &truth), Verdict::CertainRight);
+        assert_eq!(verdict(&certain(5), &truth), Verdict::CertainRight);
+        assert_eq!(verdict(&certain(7), &truth), Verdict::CertainWrong);
+        let possible = |landmarks: Vec<LandmarkId>, unidentified| Whereabouts::Possible {
+            landmarks,
+            unidentified,
+        };
+        assert_eq!(
+            verdict(&possible(vec![2, 31], 0), &truth),
+            Verdict::PossibleHolds
+        );
+        assert_eq!(
+            verdict(&possible(vec![2], 1), &truth),
+            Verdict::PossibleUnidentified
+        );
+        assert_eq!(
+            verdict(&possible(vec![2], 0), &truth),
+            Verdict::PossibleMisses
+        );
+        assert_eq!(verdict(&Whereabouts::Unknown, &truth), Verdict::Unknown);
+    }
 }
