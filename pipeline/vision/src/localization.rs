@@ -153,7 +153,7 @@ impl<C: Calculus> KnownMap<C> {
                 match decision {
                     Decision::Matched(landmark) => identified.push((i, landmark)),
                     Decision::HeldBack(candidates) => ambiguous.push((i, candidates)),
-                    Decision::New | Decision::Withheld => {}
+                    Decision::New | Decision::Withheld(_) => {}
                 }
             }
         }

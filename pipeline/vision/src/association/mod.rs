@@ -153,6 +153,8 @@ pub struct Evidence {
     /// A piece touching another detection ([`crate::ranging::Ranged::piece`]): it may be
     /// part of a rock or hold parts of two, so it observes landmarks but founds none.
     pub piece: bool,
+    /// Rock pixels of the detection: too few ([`MIN_FOUNDING_PIXELS`]) describe no looks.
+    pub pixels: u32,
 }
 
 /// One station as association sees it: the bearings and range order of its usable detections,
@@ -178,33 +180,57 @@ pub enum Decision {
     Matched(LandmarkId),
     New,
     HeldBack(Vec<LandmarkId>),
-    /// A detection that matched no landmark and founds none ([`founds_landmark`]).
-    Withheld,
+    /// A detection that matched no landmark and founds none, and why ([`unfounded`]).
+    Withheld(Unfounded),
 }
 
-/// Whether a detection that matched no landmark founds one of its own. A piece
+/// Why a detection that matched no landmark founds none of its own ([`unfounded`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unfounded {
+    /// A piece ([`Evidence::piece`]): part of a rock, or parts of two.
+    Piece,
+    /// Fewer rock pixels than [`MIN_FOUNDING_PIXELS`].
+    Small,
+    /// Placed looser than any registration pairs ([`LONG_ANCHOR_RADIUS_M`]), or not at all.
+    Loose,
+}
+
+/// Fewest rock pixels of a detection that founds a landmark: a 3 × 3 window's. A landmark's
+/// looks are those of the detection that founded it, and over fewer pixels its texture and
+/// shaded fraction are noise: such a landmark passed the looks test for most rocks later seen
+/// near its ray and held them back, while itself rarely seen again (half-resolution marsyard
+/// seed 4: a landmark founded from 4 pixels, never seen again, was a candidate of 134 held-back
+/// sightings; half-resolution marsyard seed 11 and stress seed 4 each mapped false detections
+/// of under 9 pixels).
+pub const MIN_FOUNDING_PIXELS: u32 = 9;
+
+/// Why a detection that matched no landmark founds none, if it does not. A piece
 /// ([`Evidence::piece`]) does not: it may be part of a rock or hold parts of two. Nor does a
-/// detection placed looser than any registration pairs ([`LONG_ANCHOR_RADIUS_M`], a far rock
-/// whose range interval spans metres): its landmark would stay as loose in every frame, so no
-/// later sighting could be paired with it, while every look-alike seen along its ray would
-/// take it for a candidate and be held back (half-resolution marsyard seed 4: a rock 11 m
-/// away founded a landmark placed within 7 m either way, for which 36 later sightings of it
-/// and of another rock were held back and given up; without it, the rock founded a landmark
-/// from 3.8 m, matched at 7 later stations).
-pub fn founds_landmark(evidence: &Evidence) -> bool {
-    !evidence.piece
-        && evidence
-            .placed
-            .is_some_and(|p| p.reach() <= LONG_ANCHOR_RADIUS_M)
+/// detection of fewer than [`MIN_FOUNDING_PIXELS`], or one placed looser than any registration
+/// pairs ([`LONG_ANCHOR_RADIUS_M`], a far rock whose range interval spans metres): its landmark
+/// would stay as loose in every frame, so no later sighting could be paired with it, while
+/// every look-alike seen along its ray would take it for a candidate and be held back
+/// (half-resolution marsyard seed 4: a rock 11 m away founded a landmark placed within 7 m
+/// either way, for which 36 later sightings of it and of another rock were held back and given
+/// up; without it, the rock founded a landmark from 3.8 m, matched at 7 later stations).
+pub fn unfounded(evidence: &Evidence) -> Option<Unfounded> {
+    if evidence.piece {
+        Some(Unfounded::Piece)
+    } else if evidence.pixels < MIN_FOUNDING_PIXELS {
+        Some(Unfounded::Small)
+    } else if evidence
+        .placed
+        .is_none_or(|p| p.reach() > LONG_ANCHOR_RADIUS_M)
+    {
+        Some(Unfounded::Loose)
+    } else {
+        None
+    }
 }
 
 /// A new landmark for the detection with `evidence`, unless it founds none.
 fn founded(evidence: &Evidence) -> Decision {
-    if founds_landmark(evidence) {
-        Decision::New
-    } else {
-        Decision::Withheld
-    }
+    unfounded(evidence).map_or(Decision::New, Decision::Withheld)
 }
 
 /// Associates the detections of one station with the landmarks of `map` and `gallery`;
@@ -803,6 +829,7 @@ mod tests {
                 placed: Some(at(p)),
                 ray: toward(p),
                 piece: false,
+                pixels: 100,
             })
             .collect();
         (
@@ -856,7 +883,11 @@ mod tests {
         let decisions = associate_station(&(Gallery::default(), station), &[]);
         assert_eq!(
             decisions,
-            [Decision::New, Decision::Withheld, Decision::New]
+            [
+                Decision::New,
+                Decision::Withheld(Unfounded::Piece),
+                Decision::New
+            ]
         );
     }
 
@@ -877,7 +908,28 @@ mod tests {
         let decisions = associate_station(&(Gallery::default(), station), &[]);
         assert_eq!(
             decisions,
-            [Decision::New, Decision::Withheld, Decision::New]
+            [
+                Decision::New,
+                Decision::Withheld(Unfounded::Loose),
+                Decision::New
+            ]
+        );
+    }
+
+    /// A detection of fewer pixels than a 3 × 3 window founds no landmark: its looks are noise.
+    #[test]
+    fn a_detection_too_small_to_describe_founds_no_landmark() {
+        let (_, mut station) = station(&[[5.0, 0.0], [0.0, 6.0], [-4.0, -3.0]]);
+        station.detections[1].pixels = MIN_FOUNDING_PIXELS - 1;
+        station.detections[2].pixels = MIN_FOUNDING_PIXELS;
+        let decisions = associate_station(&(Gallery::default(), station), &[]);
+        assert_eq!(
+            decisions,
+            [
+                Decision::New,
+                Decision::Withheld(Unfounded::Small),
+                Decision::New
+            ]
         );
     }
 

@@ -8,8 +8,8 @@ use super::record::{
 use super::selection;
 use crate::association::audit::{regroup, Regrouping};
 use crate::association::{
-    agreement, associate, founds_landmark, reconsider, sketch, AssociationSettings, Decision,
-    Evidence, Frame, Gallery, LastSeen, Placed, Profile, Sketch, StationEvidence,
+    agreement, associate, reconsider, sketch, unfounded, AssociationSettings, Decision, Evidence,
+    Frame, Gallery, LastSeen, Placed, Profile, Sketch, StationEvidence,
 };
 use crate::calib::Calibration;
 use crate::detection::{Detection, Separation};
@@ -225,14 +225,9 @@ impl<C: Calculus> Mapper<C> {
 
         let start = Instant::now();
         for (position, decision) in decisions.iter().enumerate() {
-            if *decision == Decision::Withheld {
-                let reason = if evidence.detections[position].piece {
-                    Exclusion::Touching
-                } else {
-                    Exclusion::Loose
-                };
+            if let Decision::Withheld(why) = decision {
                 record.detections[usable[position]].association = Association::Unused {
-                    reason: Some(reason),
+                    reason: Some(Exclusion::from(*why)),
                 };
             }
         }
@@ -594,8 +589,8 @@ impl<C: Calculus> Mapper<C> {
                     continue;
                 }
                 // Every candidate rejected: a rock the map did not have, unless the detection
-                // founds no landmark (a piece, or one placed too loosely).
-                Some(_) if !founds_landmark(&item.evidence) => {
+                // founds no landmark (a piece, too small, or placed too loosely).
+                Some(_) if unfounded(&item.evidence).is_some() => {
                     done[k] = true;
                     self.expired += 1;
                     continue;
@@ -777,7 +772,7 @@ impl Associated {
                     next_landmark += 1;
                 }
                 Decision::HeldBack(candidates) => held.push((position, candidates.clone())),
-                Decision::Withheld => {}
+                Decision::Withheld(_) => {}
             }
         }
         Associated {

@@ -2,6 +2,7 @@
 //! rerun recording, the summary) is written from. Plain data, serialised as JSON; the field
 //! meanings are documented in `docs/RUN.md`.
 
+use crate::association::Unfounded;
 use qrm_core::map::LandmarkId;
 use serde::{Deserialize, Serialize};
 
@@ -113,10 +114,12 @@ pub enum Exclusion {
     /// without its body, or no stereo to tell it from a shadow.
     Doubted,
     /// Matched no landmark and placed too loosely to found one (a far rock whose range
-    /// interval spans metres: `association::founds_landmark`).
+    /// interval spans metres: `association::unfounded`).
     Loose,
     /// Narrower than a 512th of the view: mostly pieces of larger rocks.
     Sliver,
+    /// Matched no landmark and too small to found one (`association::MIN_FOUNDING_PIXELS`).
+    Small,
     /// Taller than wide: a farther rock seen over a nearer one.
     Stacked,
     /// Its box meets another detection's (two rocks, or one rock in two pieces): left out in
@@ -124,6 +127,17 @@ pub enum Exclusion {
     Touching,
     /// Its bearing interval is too wide to measure with.
     WideBearing,
+}
+
+/// A detection that matched no landmark and founds none is recorded unused, for its reason.
+impl From<Unfounded> for Exclusion {
+    fn from(why: Unfounded) -> Exclusion {
+        match why {
+            Unfounded::Piece => Exclusion::Touching,
+            Unfounded::Small => Exclusion::Small,
+            Unfounded::Loose => Exclusion::Loose,
+        }
+    }
 }
 
 /// The outcome of fusing one panorama.

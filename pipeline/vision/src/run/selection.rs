@@ -90,6 +90,7 @@ pub(crate) fn station_evidence(
                 placed: placed(&ranged[i]),
                 ray: ranged[i].ray,
                 piece: ranged[i].piece,
+                pixels: station.primary[i].pixels,
             })
             .collect(),
         colour: station.channels == Channels::Colour,
