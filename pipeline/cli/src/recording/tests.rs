@@ -229,6 +229,18 @@ fn check(value: &Value, schema: &Value, root: &Value, at: &str) {
     }
 }
 
+/// The JSON of an MCAP message, checked against the JSON Schema its channel carries.
+fn checked(message: &::mcap::Message) -> Value {
+    let channel = &message.channel;
+    assert_eq!(channel.message_encoding, "json");
+    let schema = channel.schema.as_ref().unwrap();
+    assert_eq!(schema.encoding, "jsonschema");
+    let schema: Value = serde_json::from_slice(&schema.data).unwrap();
+    let value: Value = serde_json::from_slice(&message.data).unwrap();
+    check(&value, &schema, &schema, &channel.topic);
+    value
+}
+
 /// Records `STATIONS` stations into `dir/file` with recorders from `create`, after checking
 /// that a recording dropped unfinished leaves nothing behind; returns the finished file.
 fn record_whole(
@@ -281,12 +293,7 @@ fn mcap_has_every_channel_once_per_station_matching_its_schema() {
     for message in ::mcap::MessageStream::new(&bytes).unwrap() {
         let message = message.unwrap();
         let channel = &message.channel;
-        assert_eq!(channel.message_encoding, "json");
-        let schema = channel.schema.as_ref().unwrap();
-        assert_eq!(schema.encoding, "jsonschema");
-        let schema: Value = serde_json::from_slice(&schema.data).unwrap();
-        let value: Value = serde_json::from_slice(&message.data).unwrap();
-        check(&value, &schema, &schema, &channel.topic);
+        let value = checked(&message);
         let index = value["index"].as_u64().unwrap();
         assert_eq!(message.log_time, index * 1_000_000_000);
         assert_eq!(message.publish_time, message.log_time);
@@ -389,14 +396,8 @@ fn drive_log_has_one_message_per_step_matching_its_schema() {
     let mut seen = Vec::new();
     for (sequence, message) in ::mcap::MessageStream::new(&bytes).unwrap().enumerate() {
         let message = message.unwrap();
-        let channel = &message.channel;
-        assert_eq!(channel.topic, navigation_log::TOPIC);
-        assert_eq!(channel.message_encoding, "json");
-        let schema = channel.schema.as_ref().unwrap();
-        assert_eq!(schema.encoding, "jsonschema");
-        let schema: Value = serde_json::from_slice(&schema.data).unwrap();
-        let value: Value = serde_json::from_slice(&message.data).unwrap();
-        check(&value, &schema, &schema, &channel.topic);
+        assert_eq!(message.channel.topic, navigation_log::TOPIC);
+        let value = checked(&message);
         assert_eq!(message.log_time, sequence as u64 * 1_000_000_000);
         seen.push((
             value["trip"].as_u64().unwrap(),
