@@ -212,7 +212,7 @@ pub const MIN_FOUNDING_PIXELS: u32 = 9;
 /// every look-alike seen along its ray would take it for a candidate and be held back
 /// (half-resolution marsyard seed 4: a rock 11 m away founded a landmark placed within 7 m
 /// either way, for which 36 later sightings of it and of another rock were held back and given
-/// up; without it, the rock founded a landmark from 3.8 m, matched at 7 later stations).
+/// up; without it, the rock founded a landmark from 3.8 m, matched at 9 later stations).
 pub fn unfounded(evidence: &Evidence) -> Option<Unfounded> {
     if evidence.piece {
         Some(Unfounded::Piece)
