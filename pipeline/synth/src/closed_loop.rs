@@ -949,6 +949,8 @@ mod tests {
         );
     }
 
+    /// A map that made two landmarks of one rock: a rover at that rock is in both landmarks'
+    /// true cells, whichever of them a trip was given as its goal.
     #[test]
     fn two_landmarks_of_one_rock_share_its_true_cell() {
         let calib = default_calibration();
