@@ -874,21 +874,23 @@ mod tests {
         )
     }
 
+    /// Associates `station`, of three detections, as the first station: the first and third
+    /// found landmarks, the second none, for `why`.
+    fn only_the_second_founds_none(station: StationEvidence, why: Unfounded) {
+        let decisions = associate_station(&(Gallery::default(), station), &[]);
+        assert_eq!(
+            decisions,
+            [Decision::New, Decision::Withheld(why), Decision::New]
+        );
+    }
+
     /// The first station founds a landmark for each detection but the piece touching another,
     /// which may be part of a rock or hold parts of two.
     #[test]
     fn a_piece_founds_no_landmark() {
         let (_, mut station) = station(&[[5.0, 0.0], [0.0, 6.0], [-4.0, -3.0]]);
         station.detections[1].piece = true;
-        let decisions = associate_station(&(Gallery::default(), station), &[]);
-        assert_eq!(
-            decisions,
-            [
-                Decision::New,
-                Decision::Withheld(Unfounded::Piece),
-                Decision::New
-            ]
-        );
+        only_the_second_founds_none(station, Unfounded::Piece);
     }
 
     /// A far detection whose range interval spans metres founds no landmark: no registration
@@ -905,15 +907,7 @@ mod tests {
             LONG_ANCHOR_RADIUS_M,
             0.2,
         ));
-        let decisions = associate_station(&(Gallery::default(), station), &[]);
-        assert_eq!(
-            decisions,
-            [
-                Decision::New,
-                Decision::Withheld(Unfounded::Loose),
-                Decision::New
-            ]
-        );
+        only_the_second_founds_none(station, Unfounded::Loose);
     }
 
     /// A detection of fewer pixels than a 3 × 3 window founds no landmark: its looks are noise.
@@ -922,15 +916,7 @@ mod tests {
         let (_, mut station) = station(&[[5.0, 0.0], [0.0, 6.0], [-4.0, -3.0]]);
         station.detections[1].pixels = MIN_FOUNDING_PIXELS - 1;
         station.detections[2].pixels = MIN_FOUNDING_PIXELS;
-        let decisions = associate_station(&(Gallery::default(), station), &[]);
-        assert_eq!(
-            decisions,
-            [
-                Decision::New,
-                Decision::Withheld(Unfounded::Small),
-                Decision::New
-            ]
-        );
+        only_the_second_founds_none(station, Unfounded::Small);
     }
 
     fn frame(points: &[[f64; 2]]) -> Frame {
