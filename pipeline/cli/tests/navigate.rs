@@ -184,7 +184,8 @@ pub(super) const DEMO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../datase
 
 /// `navigate locate` places panoramas against a run's map: every cell it claims holds against
 /// the truth (a certain cell is the true one; a possible set holds it, or names a rock not
-/// identified that may be nearer), and a run's files missing or a right-eye image are errors.
+/// identified that may be nearer), its compute is timed over repeated runs, and a run's files
+/// missing or a right-eye image are errors.
 #[test]
 fn locates_panoramas_against_a_run_soundly() {
     let scratch = tempfile::tempdir().unwrap();
@@ -206,6 +207,7 @@ fn locates_panoramas_against_a_run_soundly() {
     ];
     args.extend(images.iter().map(String::as_str));
     args.extend(["--truth", &truth, "--json", answers.to_str().unwrap()]);
+    args.extend(["--repeat", "2"]);
     let o = pipeline(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let answers: serde_json::Value =
@@ -224,6 +226,12 @@ fn locates_panoramas_against_a_run_soundly() {
         );
     }
     assert!(stdout(&o).contains("over 6 panoramas"), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains("navigator compute over 6 panoramas")
+            && stdout(&o).contains("fastest of 2 runs each"),
+        "{}",
+        stdout(&o)
+    );
 
     std::fs::remove_file(run.join("landmarks.json")).unwrap();
     for (image, needle) in [
