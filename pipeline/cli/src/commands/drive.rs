@@ -3,6 +3,7 @@
 //! docs/NAVIGATION.md "Closed loop through rendered panoramas").
 
 use super::locate::{load_run, read_landmark_rocks};
+use super::quantile;
 use crate::recording::navigation_log::{self, write_drive_log};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -274,13 +275,6 @@ fn summarize(trips: &[Trip]) -> serde_json::Value {
         .flat_map(|t| t.steps.iter().map(|s| s.detect_seconds))
         .collect();
     detection.sort_by(f64::total_cmp);
-    let quantile = |v: &[f64], q: f64| {
-        if v.is_empty() {
-            f64::NAN
-        } else {
-            v[((v.len() - 1) as f64 * q).round() as usize]
-        }
-    };
     let mut ratios: Vec<f64> = trips
         .iter()
         .filter(|t| t.outcome == Outcome::Arrived && t.in_goal_cell && t.length_m > 0.0)

@@ -5,6 +5,7 @@
 
 use super::map::{calculus_of, read};
 use super::output::write_atomic;
+use super::quantile;
 use super::run::ChannelsArg;
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -188,19 +189,19 @@ struct Compute {
 
 /// Median, 90th percentile and worst of the panoramas' compute, and the median detection.
 fn describe_compute(computes: &[Compute], repeat: u32) -> String {
-    let quantile = |mut values: Vec<f64>, q: f64| {
+    let sorted = |seconds: fn(&Compute) -> f64| {
+        let mut values: Vec<f64> = computes.iter().map(seconds).collect();
         values.sort_by(f64::total_cmp);
-        values[((values.len() - 1) as f64 * q).round() as usize]
+        values
     };
-    let total: Vec<f64> = computes.iter().map(|c| c.total).collect();
-    let detect: Vec<f64> = computes.iter().map(|c| c.detect).collect();
+    let (total, detect) = (sorted(|c| c.total), sorted(|c| c.detect));
     format!(
         "navigator compute over {} panoramas (detection to cell, decoding excluded; fastest of {repeat} runs each): median {:.3} s, p90 {:.3} s, worst {:.3} s; detection median {:.3} s",
         computes.len(),
-        quantile(total.clone(), 0.5),
-        quantile(total.clone(), 0.9),
-        quantile(total, 1.0),
-        quantile(detect, 0.5),
+        quantile(&total, 0.5),
+        quantile(&total, 0.9),
+        quantile(&total, 1.0),
+        quantile(&detect, 0.5),
     )
 }
 

@@ -27,6 +27,16 @@ pub enum CalculusName {
     Fdc,
 }
 
+/// The value at fraction `q` of ascending `sorted` (nearest rank; NaN when empty): the
+/// medians and 90th percentiles the navigation commands report.
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        f64::NAN
+    } else {
+        sorted[((sorted.len() - 1) as f64 * q).round() as usize]
+    }
+}
+
 /// The RNG estimate as JSON (format in docs/MAP_FORMAT.md).
 pub fn rng_json<C: Calculus>(map: &Hypergraph<C>, rng: &RngEstimate) -> String {
     let edges: Vec<_> = rng
