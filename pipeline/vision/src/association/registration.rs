@@ -733,21 +733,31 @@ impl Motion {
     }
 }
 
-/// The look-alike correspondences of one registration as a table of placed detections by the
-/// frame's landmarks: scoring a motion hypothesis ([`matches`]) is then a tight loop. A
+/// The look-alike correspondences of one registration, each placed detection with the list of
+/// its look-alike landmarks: scoring a motion hypothesis ([`matches`]) is then a tight loop. A
 /// registration tries hundreds of hypotheses against a few hundred correspondences each;
 /// against every station of a run (`navigate`'s localization) that was most of a step.
 struct Candidates {
-    /// Detections with a placement and a look-alike in the frame: index, point, placement
-    /// grown by half the slack, and that grown placement's reach.
-    detections: Vec<(usize, [f64; 2], Matrix2<f64>, f64)>,
-    /// The frame's landmarks: coordinates, placements grown by half the slack, their reach.
-    x: Vec<f64>,
-    y: Vec<f64>,
+    /// Detections with a placement and a look-alike in the frame.
+    detections: Vec<Candidate>,
+    /// Each detection's look-alike landmarks in turn: the landmark's index into the frame's
+    /// landmarks, its coordinates and its grown placement's reach, side by side so that the
+    /// distance test runs over them without looking up the others.
+    alike: Vec<(usize, [f64; 2], f64)>,
+    /// The frame's landmarks' placements grown by half the slack.
     grown: Vec<Matrix2<f64>>,
-    reach: Vec<f64>,
-    /// `alike[k × landmarks + j]`: detection `detections[k]` may be landmark `j`.
-    alike: Vec<bool>,
+}
+
+/// One placed detection of [`Candidates`].
+struct Candidate {
+    /// Its index in the station, its point, its placement grown by half the slack and that
+    /// grown placement's reach.
+    detection: usize,
+    point: [f64; 2],
+    grown: Matrix2<f64>,
+    reach: f64,
+    /// Where its look-alikes lie in [`Candidates::alike`].
+    alike: std::ops::Range<usize>,
 }
 
 impl Candidates {
@@ -758,33 +768,28 @@ impl Candidates {
         frame: &Frame,
         correspondences: &[(usize, usize)],
     ) -> Candidates {
-        let n = frame.landmarks.len();
         let half = 0.5 * SLACK_M;
-        let mut detections = Vec::new();
-        let mut alike: Vec<bool> = Vec::new();
+        let mut detections: Vec<Candidate> = Vec::new();
+        let mut alike = Vec::new();
         for &(i, j) in correspondences {
-            if detections
-                .last()
-                .is_none_or(|&(k, _, _, _): &(usize, _, _, _)| k != i)
-            {
+            if detections.last().is_none_or(|d| d.detection != i) {
                 let p = current[i].expect("correspondences are placed");
-                detections.push((i, p.point, p.grown(half), p.reach() + half));
-                alike.resize(alike.len() + n, false);
+                detections.push(Candidate {
+                    detection: i,
+                    point: p.point,
+                    grown: p.grown(half),
+                    reach: p.reach() + half,
+                    alike: alike.len()..alike.len(),
+                });
             }
-            let row = detections.len() - 1;
-            alike[row * n + j] = true;
+            let q = frame.landmarks[j].1;
+            alike.push((j, q.point, q.reach() + half));
+            detections.last_mut().expect("pushed above").alike.end = alike.len();
         }
         Candidates {
             detections,
-            x: frame.landmarks.iter().map(|(_, q)| q.point[0]).collect(),
-            y: frame.landmarks.iter().map(|(_, q)| q.point[1]).collect(),
-            grown: frame.landmarks.iter().map(|(_, q)| q.grown(half)).collect(),
-            reach: frame
-                .landmarks
-                .iter()
-                .map(|(_, q)| q.reach() + half)
-                .collect(),
             alike,
+            grown: frame.landmarks.iter().map(|(_, q)| q.grown(half)).collect(),
         }
     }
 }
@@ -792,22 +797,21 @@ impl Candidates {
 /// The one-to-one correspondences (nearest first, by [`Separation`] distance) that `motion`
 /// brings within tolerance, and the fit score Σ (1 − (distance / gate)²).
 fn matches(candidates: &Candidates, motion: &Motion) -> (Vec<(usize, usize)>, f64) {
-    let n = candidates.x.len();
     let mut close: Vec<(f64, usize, usize, f64)> = Vec::new();
-    for (row, &(i, point, grown, reach)) in candidates.detections.iter().enumerate() {
-        let [mx, my] = motion.apply(point);
-        let alike = &candidates.alike[row * n..(row + 1) * n];
+    for candidate in &candidates.detections {
+        let (i, grown, reach) = (candidate.detection, &candidate.grown, candidate.reach);
+        let [mx, my] = motion.apply(candidate.point);
         let mut turned = None;
-        for j in (0..n).filter(|&j| alike[j]) {
-            let (dx, dy) = (mx - candidates.x[j], my - candidates.y[j]);
+        for &(j, [x, y], landmark_reach) in &candidates.alike[candidate.alike.clone()] {
+            let (dx, dy) = (mx - x, my - y);
             // Beyond both placements' reach the pair is off whatever their shapes; most pairs
             // are, and the test needs no ellipse.
-            let bound = reach + candidates.reach[j];
+            let bound = reach + landmark_reach;
             if dx * dx + dy * dy > bound * bound * (1.0 + 1e-9) {
                 continue;
             }
             let turned =
-                *turned.get_or_insert_with(|| turned_shape(&grown, [motion.cos, motion.sin]));
+                *turned.get_or_insert_with(|| turned_shape(grown, [motion.cos, motion.sin]));
             let separation = separation_of(
                 Vector2::new(dx, dy),
                 &bound_of_sum(&turned, &candidates.grown[j]),
