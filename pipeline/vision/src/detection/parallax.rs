@@ -82,6 +82,13 @@ pub enum Separation {
 const MAX_COSTS: usize = 1 << 24;
 const MAX_WORK: usize = 1 << 27;
 
+/// Blobs whose matching would take more window sums than this are matched at half resolution
+/// (2 × 2 means, a quarter of the pixels over half the shifts: an eighth of the work). Only a
+/// large rock close to the rover reaches it (tens of thousands of pixels over 100–190 shifts;
+/// up to a seventh of a second on one core at 4096 columns), and its shifts are large: a
+/// shift found to a fraction of a half-resolution column still gives its range to about 1 %.
+const COARSE_WORK: usize = 1 << 22;
+
 /// A connected part of a blob at one range.
 pub(super) struct Layer {
     pub pixels: Component,
@@ -129,12 +136,27 @@ pub(super) fn layers(
             shifts: None,
         }];
     }
-    let shifts = pixel_shifts(&pixels, partner, max_shift, rule.radius);
+    let scale = if work > COARSE_WORK { 2 } else { 1 };
+    layers_at(pixels, partner, max_shift, rule, scale)
+}
+
+/// [`layers`], matching at `scale` (1, or 2 for half resolution).
+fn layers_at(
+    pixels: Component,
+    partner: &Partner,
+    max_shift: usize,
+    rule: ParallaxRule,
+    scale: u32,
+) -> Vec<Layer> {
+    let shifts = pixel_shifts(&pixels, partner, max_shift, rule.radius, scale);
+    // Pixels a window apart across an occluding edge: the window is `scale` times wider at
+    // half resolution.
+    let window = (2 * rule.radius + 1) * scale as usize;
     let mut out = Vec::new();
     let mut pending = vec![(pixels, shifts, Separation::Whole, 0)];
     while let Some((pixels, shifts, part, depth)) = pending.pop() {
         let labels = if depth < 2 {
-            separate(&pixels, &shifts, partner, rule)
+            separate(&pixels, &shifts, partner, rule, window)
         } else {
             None
         };
@@ -191,6 +213,7 @@ fn separate(
     shifts: &[Option<f32>],
     partner: &Partner,
     rule: ParallaxRule,
+    window: usize,
 ) -> Option<Vec<bool>> {
     if pixels.len() < rule.min_pixels {
         return None;
@@ -204,22 +227,39 @@ fn separate(
     let mut candidates = vec![threshold];
     candidates.extend(two_groups(&reliable[..k]).map(|t| t.0));
     candidates.extend(two_groups(&reliable[k..]).map(|t| t.0));
-    let index = PixelIndex::new(pixels);
+    let blob = Matched {
+        pixels,
+        index: PixelIndex::new(pixels),
+        shifts,
+        window,
+    };
     candidates
         .into_iter()
-        .find_map(|t| separate_at(pixels, &index, shifts, &reliable, t, partner, rule))
+        .find_map(|t| separate_at(&blob, &reliable, t, partner, rule))
+}
+
+/// A blob's pixels with their shifts, and the matching window's width (pixels).
+struct Matched<'a> {
+    pixels: &'a Component,
+    index: PixelIndex,
+    shifts: &'a [Option<f32>],
+    window: usize,
 }
 
 /// The labels of a separation of the blob at shift `threshold`, if it passes `rule`.
 fn separate_at(
-    pixels: &Component,
-    index: &PixelIndex,
-    shifts: &[Option<f32>],
+    blob: &Matched,
     reliable: &[f32],
     threshold: f32,
     partner: &Partner,
     rule: ParallaxRule,
 ) -> Option<Vec<bool>> {
+    let Matched {
+        pixels,
+        ref index,
+        shifts,
+        window,
+    } = *blob;
     let k = reliable.partition_point(|&s| s <= threshold);
     let share = k.min(reliable.len() - k) as f32 / reliable.len() as f32;
     if share < rule.min_share || share == 0.0 {
@@ -249,7 +289,7 @@ fn separate_at(
     let half_width = 0.5 * widest * partner.column_width * near_range;
     // The jump across the border, not the groups' means, says how far apart the two surfaces
     // are: the means also hold each surface's own slope.
-    let step = border_step(pixels, index, shifts, &labels, rule.radius)?;
+    let step = border_step(pixels, index, shifts, &labels, window)?;
     let behind = partner.range(near - step) - near_range;
     (step >= rule.step_ratio * (near - far)
         && step >= rule.min_step_px.max(rule.min_step_fraction * near)
@@ -261,21 +301,67 @@ fn column_span(pixels: &[(u32, u32)]) -> f64 {
     bounds(pixels).map_or(0.0, |[c0, _, c1, _]| f64::from(c1 - c0 + 1))
 }
 
-/// Block matching: each pixel's shift into the other panorama (sub-pixel), or `None` where the
-/// match is not unique. Costs are mean absolute luminance differences over a square window,
-/// from an integral image of the region per shift.
+/// Block matching: each pixel's shift into the other panorama (sub-pixel, columns), or `None`
+/// where the match is not unique. At `scale` 2 the panoramas are matched at half resolution
+/// (`COARSE_WORK`): each pixel takes the shift of its 2 × 2 cell, doubled.
 fn pixel_shifts(
     pixels: &Component,
     partner: &Partner,
     max_shift: usize,
     radius: usize,
+    scale: u32,
 ) -> Vec<Option<f32>> {
+    let (cells, cell_of) = cells(pixels, scale);
+    let step = scale as usize;
+    let shifts = cell_shifts(&cells, partner, max_shift / step, radius, step);
+    cell_of
+        .into_iter()
+        .map(|c| shifts[c].map(|s| s * scale as f32))
+        .collect()
+}
+
+/// The distinct `scale` × `scale` cells that `pixels` fall in, and each pixel's cell.
+fn cells(pixels: &Component, scale: u32) -> (Component, Vec<usize>) {
+    let coarse: Component = pixels
+        .iter()
+        .map(|&(c, r)| (c / scale, r / scale))
+        .collect();
+    let [c0, r0, c1, r1] = bounds(&coarse).unwrap_or([0; 4]);
+    let cols = (c1 - c0) as usize + 1;
+    let mut slots = vec![usize::MAX; cols * ((r1 - r0) as usize + 1)];
+    let mut cells = Component::new();
+    let cell_of = coarse
+        .into_iter()
+        .map(|(c, r)| {
+            let slot = &mut slots[(r - r0) as usize * cols + (c - c0) as usize];
+            if *slot == usize::MAX {
+                *slot = cells.len();
+                cells.push((c, r));
+            }
+            *slot
+        })
+        .collect();
+    (cells, cell_of)
+}
+
+/// Each cell's shift in cells (sub-pixel), or `None` where the match is not unique: a cell is
+/// `scale` × `scale` pixels, matched by the sum of their luminance. Costs are mean absolute
+/// luminance differences over a square window of cells, from an integral image of the region
+/// per shift.
+fn cell_shifts(
+    pixels: &Component,
+    partner: &Partner,
+    max_shift: usize,
+    radius: usize,
+    scale: usize,
+) -> Vec<Option<f32>> {
+    let rows = partner.rows.div_ceil(scale);
     let [col_min, row_min, col_max, row_max] = bounds(pixels).unwrap_or([0; 4]).map(|v| v as usize);
     // Region: the bounding box grown by the window; columns unwrapped from `x0`.
     let x0 = col_min as isize - radius as isize;
     let rw = col_max - col_min + 1 + 2 * radius;
     let y0 = row_min.saturating_sub(radius);
-    let rh = (row_max + radius).min(partner.rows - 1) - y0 + 1;
+    let rh = (row_max + radius).min(rows - 1) - y0 + 1;
     let shifts = max_shift + 1;
     // The other panorama's rows cover the region at every shift: shift `s` starts at
     // `s` (direction +1) or `max_shift − s` (direction −1).
@@ -287,7 +373,13 @@ fn pixel_shifts(
     };
     let w = partner.width as isize;
     let read = |img: &[u16], y: usize, x: isize| {
-        i32::from(img[y * partner.width + x.rem_euclid(w) as usize])
+        let mut sum = 0;
+        for row in (y * scale..(y + 1) * scale).map(|r| r.min(partner.rows - 1)) {
+            for col in x * scale as isize..(x + 1) * scale as isize {
+                sum += i32::from(img[row * partner.width + col.rem_euclid(w) as usize]);
+            }
+        }
+        sum
     };
     let own: Vec<i32> = (0..rh)
         .flat_map(|y| (0..rw).map(move |x| (y, x)))
@@ -304,7 +396,13 @@ fn pixel_shifts(
             let cy = row as usize - y0;
             let (ya, yb) = (cy.saturating_sub(radius), (cy + radius + 1).min(rh));
             let (xa, xb) = (cx - radius, cx + radius + 1);
-            (xa, xb, ya, yb, 1.0 / ((xb - xa) * (yb - ya)) as f32)
+            (
+                xa,
+                xb,
+                ya,
+                yb,
+                1.0 / ((xb - xa) * (yb - ya) * scale * scale) as f32,
+            )
         })
         .collect();
     // Filled shift by shift, pixel after pixel (written in a pixel's row of shifts, the costs
@@ -483,7 +581,7 @@ fn absorb_fragments(
     }
 }
 
-/// The median shift difference of reliable pixels a window apart across the border between
+/// The median shift difference of reliable pixels a `window` apart across the border between
 /// the two groups, if enough such pairs exist: a step at an occluding edge, where one rock's
 /// sloping face differs little over so short a distance.
 fn border_step(
@@ -491,9 +589,9 @@ fn border_step(
     index: &PixelIndex,
     shifts: &[Option<f32>],
     labels: &[bool],
-    radius: usize,
+    window: usize,
 ) -> Option<f32> {
-    let gap = 2 * radius as i64 + 1;
+    let gap = window as i64;
     let mut across = Vec::new();
     for (k, &(col, row)) in pixels.iter().enumerate() {
         let Some(s) = shifts[k] else { continue };
@@ -719,6 +817,75 @@ mod tests {
             layers(pixels, &partner(&own, &other, 1), 28, without_depth_rule()).len(),
             2
         );
+    }
+
+    /// The same scene at nearly twice the shifts (a rock at 9.8 m over one at 6.1 m), matched
+    /// at half resolution as a large rock near the rover is: two layers, each with its own
+    /// rock's pixels and shifts, within two columns (one column at half resolution).
+    #[test]
+    fn a_farther_rock_over_a_nearer_one_is_separated_at_half_resolution() {
+        let near_covers = ellipse(140.0, 62.0, 45.0, 22.0);
+        for direction in [1, -1] {
+            let far = at_shift(1, ellipse(150.0, 35.0, 40.0, 25.0), 20.0);
+            let near = at_shift(2, ellipse(140.0, 62.0, 45.0, 22.0), 32.0);
+            let (own, other, pixels) = scene(&[far, near], direction as f64, 0);
+            let layers = layers_at(pixels, &partner(&own, &other, direction), 48, rule(), 2);
+            assert_eq!(layers.len(), 2, "{direction}");
+            for layer in &layers {
+                let wrong = layer
+                    .pixels
+                    .iter()
+                    .filter(|&&(x, y)| {
+                        near_covers(f64::from(x), f64::from(y))
+                            == (layer.part == Separation::Farther)
+                    })
+                    .count();
+                assert!(
+                    wrong * 10 < layer.pixels.len(),
+                    "{wrong} of {} pixels in the wrong layer ({:?}; {direction})",
+                    layer.pixels.len(),
+                    layer.part
+                );
+                let [low, high] = layer.shifts.expect("a separated layer has shifts");
+                let own = if layer.part == Separation::Farther {
+                    20.0
+                } else {
+                    32.0
+                };
+                assert!(
+                    (own - 2.0..=own + 2.0).contains(&low) && (low..=own + 2.0).contains(&high),
+                    "{:?}: shifts {low}–{high}, its rock's {own}",
+                    layer.part
+                );
+            }
+        }
+    }
+
+    /// Each pixel of a rock face at one range takes its 2 × 2 cell's shift, doubled: the
+    /// face's shift within a column of what matching at full resolution finds, for nine in
+    /// ten of the pixels away from the face's edge.
+    #[test]
+    fn half_resolution_shifts_are_the_full_resolution_ones_within_a_column() {
+        let rock = at_shift(1, ellipse(150.0, 45.0, 50.0, 30.0), 27.0);
+        let (own, other, pixels) = scene(&[rock], 1.0, 0);
+        let partner = partner(&own, &other, 1);
+        let full = pixel_shifts(&pixels, &partner, 40, 2, 1);
+        let half = pixel_shifts(&pixels, &partner, 40, 2, 2);
+        let inside = |&&(x, y): &&(u32, u32)| {
+            ((f64::from(x) - 150.0) / 44.0).powi(2) + ((f64::from(y) - 45.0) / 24.0).powi(2) <= 1.0
+        };
+        let (mut inner, mut compared) = (0, 0);
+        for (p, (f, h)) in pixels.iter().zip(full.iter().zip(&half)) {
+            if !inside(&p) {
+                continue;
+            }
+            inner += 1;
+            let (Some(f), Some(h)) = (f, h) else { continue };
+            assert!((f - 27.0).abs() < 0.5, "{p:?}: full resolution {f}");
+            assert!((h - f).abs() < 1.0, "{p:?}: half {h}, full {f}");
+            compared += 1;
+        }
+        assert!(compared * 10 > inner * 9, "{compared} of {inner}");
     }
 
     #[test]
