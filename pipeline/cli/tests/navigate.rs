@@ -163,6 +163,53 @@ fn simulates_navigation_and_writes_its_outputs() {
     }
 }
 
+/// `navigate simulate` with several numbers of images and λ values runs a sweep: a row per
+/// setting in sweep.csv, every trip in trips.csv, and the figure; λ values without images
+/// are refused.
+#[test]
+fn sweeps_the_images_mapped_and_lambda() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let o = pipeline(&[
+        "navigate",
+        "simulate",
+        "--worlds",
+        "2",
+        "--landmarks",
+        "12",
+        "--pairs",
+        "5",
+        "--images",
+        "4,8",
+        "--lambda",
+        "0,10",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for file in [
+        "trips.csv",
+        "sweep.csv",
+        "summary.json",
+        "sweep.png",
+        "sweep.svg",
+    ] {
+        assert!(dir.join(file).is_file(), "{file}");
+    }
+    let sweep = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    let rows: Vec<&str> = sweep.lines().skip(1).collect();
+    assert_eq!(rows.len(), 4, "{sweep}");
+    assert!(rows[0].starts_with("4,0,10,") && rows[3].starts_with("8,10,10,"));
+    let trips = std::fs::read_to_string(dir.join("trips.csv")).unwrap();
+    assert_eq!(trips.lines().count(), 1 + 4 * 10);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["settings"].as_array().unwrap().len(), 4);
+    let o = pipeline(&["navigate", "simulate", "--lambda", "0,1"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--images"));
+}
+
 /// The demo set mapped (and scored) into `dir/run`.
 pub(super) fn demo_run(dir: &Path) -> std::path::PathBuf {
     let run = dir.join("run");
@@ -353,6 +400,83 @@ fn drives_through_the_rendered_world_without_seeing_it() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("eval.json"));
+}
+
+/// `navigate flowfield` decides a heading (or arrival, or none) at every grid point clear of
+/// the rocks from the panorama rendered there, and draws them with the trips; a goal the run
+/// does not have is an error naming the landmarks it has.
+#[test]
+fn draws_the_closed_loop_flow_field() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let run = demo_run(dir);
+    let eval: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("eval.json")).unwrap()).unwrap();
+    let goal = eval["landmark_rocks"]
+        .as_object()
+        .unwrap()
+        .keys()
+        .next()
+        .unwrap()
+        .clone();
+    let out = dir.join("flow");
+    let flowfield = |goal: &str| {
+        pipeline(&[
+            "navigate",
+            "flowfield",
+            "--images",
+            DEMO,
+            "--run",
+            run.to_str().unwrap(),
+            "--goal",
+            goal,
+            "--grid",
+            "4",
+            "--trips",
+            "1",
+            "--max-steps",
+            "6",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let o = flowfield(&goal);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for file in [
+        "flowfield.png",
+        "flowfield.svg",
+        "headings.csv",
+        "trips.json",
+    ] {
+        assert!(out.join(file).is_file(), "{file}");
+    }
+    let csv = std::fs::read_to_string(out.join("headings.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert!(!rows.is_empty() && rows.len() <= 16, "{csv}");
+    for row in &rows {
+        let commands = [
+            "toward",
+            "closing_in",
+            "arrived",
+            "start_unknown",
+            "no_route",
+            "lost",
+        ];
+        assert!(commands.contains(&row[2]), "{row:?}");
+        // A heading exactly where the navigator moves.
+        assert_eq!(
+            !row[4].is_empty(),
+            row[2] == "toward" || row[2] == "closing_in",
+            "{row:?}"
+        );
+    }
+    let o = flowfield("999");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("landmark 999"));
 }
 
 /// With the `rerun` feature, `navigate drive --rrd` adds `drive.rrd`. With

@@ -11,8 +11,8 @@ use super::ticks::tick_formatter;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::{
-    ChartBuilder, Circle, DrawingArea, DrawingAreaErrorKind, DrawingBackend, PathElement,
-    TriangleMarker,
+    ChartBuilder, Circle, Cross, DrawingArea, DrawingAreaErrorKind, DrawingBackend, PathElement,
+    Polygon, TriangleMarker,
 };
 use plotters::style::{Color, IntoFont, RGBColor, WHITE};
 use std::path::Path;
@@ -27,12 +27,21 @@ pub struct FlowPicture {
     pub edges: Vec<(usize, usize, f64)>,
     /// The true RNG, dashed grey underneath (empty: not drawn).
     pub true_edges: Vec<(usize, usize)>,
-    /// `(point, unit direction)` of motion (red arrows).
+    /// `(point, unit direction)` of motion (red arrows), drawn `arrow_length` long.
     pub arrows: Vec<((f64, f64), (f64, f64))>,
+    pub arrow_length: f64,
+    /// Points of the grid where the navigator says it has arrived in the goal's cell (purple
+    /// dots), and where it chose no heading (grey crosses: nothing identified, no route, or
+    /// the route's landmark lost).
+    pub arrived: Vec<(f64, f64)>,
+    pub undecided: Vec<(f64, f64)>,
     /// The goal (green triangle).
     pub goal: (f64, f64),
     /// Driven paths, start first (blue lines from filled circles).
     pub trips: Vec<Vec<(f64, f64)>>,
+    /// Obstacles on the ground, `(centre, radius)` (light grey discs): the rocks' footprints
+    /// in a rendered world.
+    pub rocks: Vec<((f64, f64), f64)>,
     pub side: f64,
 }
 
@@ -46,6 +55,11 @@ const ARROW: RGBColor = RGBColor(220, 30, 30);
 const TRIP: RGBColor = RGBColor(30, 80, 230);
 const GOAL: RGBColor = RGBColor(20, 160, 40);
 const TRUE_EDGE: RGBColor = RGBColor(170, 170, 170);
+const ARRIVED: RGBColor = RGBColor(140, 60, 170);
+const UNDECIDED: RGBColor = RGBColor(110, 110, 110);
+const ROCK: RGBColor = RGBColor(215, 215, 215);
+/// Sides of the polygon a rock's footprint is drawn as.
+const ROCK_SIDES: usize = 24;
 /// Samples per side for tracing the Voronoi borders.
 const BORDER_SAMPLES: usize = 450;
 
@@ -69,12 +83,26 @@ fn validate(picture: &FlowPicture) -> Result<(), String> {
     if !(picture.side > 0.0 && picture.side.is_finite()) {
         return Err(format!("side {} is not a positive length", picture.side));
     }
+    if !(picture.arrow_length > 0.0 && picture.arrow_length.is_finite()) {
+        return Err(format!(
+            "arrow length {} is not a positive length",
+            picture.arrow_length
+        ));
+    }
+    if let Some(rock) = picture
+        .rocks
+        .iter()
+        .find(|(c, r)| !(c.0.is_finite() && c.1.is_finite() && *r >= 0.0 && r.is_finite()))
+    {
+        return Err(format!("rock {rock:?} is not a finite disc"));
+    }
     let finite = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite();
     let points = picture
         .landmarks
         .iter()
         .chain(picture.trips.iter().flatten())
         .chain(picture.arrows.iter().flat_map(|(p, d)| [p, d]))
+        .chain(picture.arrived.iter().chain(&picture.undecided))
         .chain(std::iter::once(&picture.goal));
     if let Some(p) = points.into_iter().find(|p| !finite(p)) {
         return Err(format!("{p:?} is not a finite position"));
@@ -132,7 +160,14 @@ impl FlowPicture {
     }
 
     fn legend(&self) -> Vec<Entry> {
-        let mut entries = vec![
+        let mut entries = Vec::new();
+        if !self.rocks.is_empty() {
+            entries.push(Entry {
+                key: Key::Circle(ROCK),
+                label: "rock footprint".into(),
+            });
+        }
+        entries.extend([
             Entry {
                 key: Key::Ring(LANDMARK),
                 label: "landmark".into(),
@@ -141,7 +176,7 @@ impl FlowPicture {
                 key: Key::Line(BORDER),
                 label: "Voronoi cell border".into(),
             },
-        ];
+        ]);
         entries.extend(legend::edge_entries(
             &self.edges,
             !self.true_edges.is_empty(),
@@ -151,6 +186,18 @@ impl FlowPicture {
             entries.push(Entry {
                 key: Key::Line(ARROW),
                 label: "direction of motion".into(),
+            });
+        }
+        if !self.arrived.is_empty() {
+            entries.push(Entry {
+                key: Key::Circle(ARRIVED),
+                label: "arrived (as the navigator sees it)".into(),
+            });
+        }
+        if !self.undecided.is_empty() {
+            entries.push(Entry {
+                key: Key::Cross(UNDECIDED),
+                label: "no heading: nothing identified, no route, or lost".into(),
             });
         }
         if !self.trips.is_empty() {
@@ -200,6 +247,15 @@ impl Figure for FlowPicture {
             .label_style((FAMILY, 17).into_font())
             .axis_desc_style((FAMILY, 20).into_font())
             .draw()?;
+        chart.draw_series(self.rocks.iter().map(|&((x, y), r)| {
+            let outline: Vec<(f64, f64)> = (0..ROCK_SIDES)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * k as f64 / ROCK_SIDES as f64;
+                    (x + r * a.cos(), y + r * a.sin())
+                })
+                .collect();
+            Polygon::new(outline, ROCK.filled())
+        }))?;
         chart.draw_series(
             self.borders()
                 .into_iter()
@@ -216,7 +272,7 @@ impl Figure for FlowPicture {
                 .iter()
                 .map(|&(i, j, w)| PathElement::new([at(i), at(j)], cost_colour(w).stroke_width(2))),
         )?;
-        let length = 0.02 * self.side;
+        let length = self.arrow_length;
         chart.draw_series(self.arrows.iter().flat_map(|&((x, y), (dx, dy))| {
             let tip = (x + length * dx, y + length * dy);
             let head = |turn: f64| {
@@ -229,6 +285,16 @@ impl Figure for FlowPicture {
                 PathElement::new(vec![head(0.5), tip, head(-0.5)], ARROW.stroke_width(2)),
             ]
         }))?;
+        chart.draw_series(
+            self.arrived
+                .iter()
+                .map(|&p| Circle::new(p, 4, ARRIVED.filled())),
+        )?;
+        chart.draw_series(
+            self.undecided
+                .iter()
+                .map(|&p| Cross::new(p, 5, UNDECIDED.stroke_width(2))),
+        )?;
         chart.draw_series(
             self.trips
                 .iter()
@@ -266,6 +332,10 @@ mod tests {
             edges: vec![(0, 1, 0.0), (1, 2, 0.4)],
             true_edges: vec![(0, 1), (1, 2), (0, 2)],
             arrows: vec![((10.0, 10.0), (1.0, 0.0))],
+            arrow_length: 2.0,
+            rocks: vec![((30.0, 60.0), 3.0)],
+            arrived: vec![(50.0, 70.0)],
+            undecided: vec![(90.0, 90.0)],
             goal: (55.0, 75.0),
             trips: vec![vec![(5.0, 5.0), (20.0, 20.0), (55.0, 75.0)]],
             side: 100.0,

@@ -8,7 +8,7 @@ use super::font::FAMILY;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::{
-    Circle, DrawingArea, DrawingAreaErrorKind, DrawingBackend, PathElement, Rectangle, Text,
+    Circle, Cross, DrawingArea, DrawingAreaErrorKind, DrawingBackend, PathElement, Rectangle, Text,
     TriangleMarker,
 };
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -33,6 +33,8 @@ pub(super) enum Key {
     Triangle(RGBColor),
     /// An open box (a detection's outline on a panorama).
     Box(RGBColor),
+    /// A diagonal cross marker.
+    Cross(RGBColor),
     /// The edge-cost colours for `0 < w ≤ 1`.
     CostScale,
 }
@@ -198,6 +200,7 @@ fn draw_swatch<DB: DrawingBackend>(
             [(x + 8, y - 8), (x + SWATCH_WIDTH - 8, y + 8)],
             colour.stroke_width(2),
         )),
+        Key::Cross(colour) => area.draw(&Cross::new(middle, 6, colour.stroke_width(2))),
         Key::CostScale => {
             for step in 0..SCALE_WIDTH {
                 let w = f64::from(step + 1) / f64::from(SCALE_WIDTH);

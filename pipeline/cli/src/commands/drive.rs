@@ -42,15 +42,8 @@ pub struct DriveArgs {
     /// their goal, for the figure).
     #[arg(long, default_value_t = 20)]
     trips: usize,
-    /// Step length, metres.
-    #[arg(long, default_value_t = 0.5)]
-    step: f64,
-    /// Steps before a trip is given up.
-    #[arg(long, default_value_t = 120)]
-    max_steps: usize,
-    /// Weight λ of an edge's RNG cost against one hop.
-    #[arg(long, default_value_t = 1.0)]
-    lambda: f64,
+    #[command(flatten)]
+    driving: DrivingArgs,
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Also write OUT/drive.rrd for the rerun viewer (needs a build with `--features rerun`).
@@ -61,49 +54,104 @@ pub struct DriveArgs {
     out: PathBuf,
 }
 
-pub fn run(args: &DriveArgs) -> Result<()> {
-    if !(args.step > 0.0 && args.step.is_finite()) {
-        bail!("--step {} must be a positive length", args.step);
+/// What `navigate drive` and `navigate flowfield` drive in and on: a synthetic dataset's world
+/// rendered again, and the map of a run over it with its RNG estimate and route graph.
+pub(super) struct ClosedLoop {
+    pub calib: Calibration,
+    pub world: World,
+    /// "preset P, seed S".
+    pub origin: String,
+    pub known: KnownMap<Edc>,
+    /// The rock each landmark stands for (eval.json), for judging.
+    pub landmark_rocks: BTreeMap<LandmarkId, u32>,
+    pub rng_estimate: RngEstimate,
+    pub graph: RouteGraph,
+}
+
+impl ClosedLoop {
+    pub fn load(images: &Path, run: &Path) -> Result<ClosedLoop> {
+        let (calib, world, origin) = rendered_world(images)?;
+        let (known, landmark_rocks) = run_of(run, &world, images)?;
+        let rng_estimate = estimate(&known.map).expect("EDC has a lune");
+        let graph = RouteGraph::new(known.map.landmarks(), &rng_estimate);
+        Ok(ClosedLoop {
+            calib,
+            world,
+            origin,
+            known,
+            landmark_rocks,
+            rng_estimate,
+            graph,
+        })
     }
+
+    pub fn terrain(&self) -> Terrain<'_> {
+        Terrain {
+            world: &self.world,
+            calib: &self.calib,
+            landmark_rocks: &self.landmark_rocks,
+        }
+    }
+}
+
+/// How the rover drives (`navigate drive` and `navigate flowfield`).
+#[derive(Args, Debug)]
+pub(super) struct DrivingArgs {
+    /// Step length, metres.
+    #[arg(long, default_value_t = 0.5)]
+    step: f64,
+    /// Steps before a trip is given up.
+    #[arg(long, default_value_t = 120)]
+    max_steps: usize,
+    /// Weight λ of an edge's RNG cost against one hop.
+    #[arg(long, default_value_t = 1.0)]
+    lambda: f64,
+}
+
+impl DrivingArgs {
+    pub fn driving(&self) -> Result<Driving> {
+        if !(self.step > 0.0 && self.step.is_finite()) {
+            bail!("--step {} must be a positive length", self.step);
+        }
+        if !(self.lambda >= 0.0 && self.lambda.is_finite()) {
+            bail!("--lambda {} must be a finite number ≥ 0", self.lambda);
+        }
+        Ok(Driving {
+            step_m: self.step,
+            max_steps: self.max_steps,
+            cost: RouteCost {
+                lambda: self.lambda,
+            },
+        })
+    }
+}
+
+pub fn run(args: &DriveArgs) -> Result<()> {
     if args.trips == 0 {
         bail!("--trips must be at least 1");
     }
-    if !(args.lambda >= 0.0 && args.lambda.is_finite()) {
-        bail!("--lambda {} must be a finite number ≥ 0", args.lambda);
-    }
+    let driving = args.driving.driving()?;
     #[cfg(not(feature = "rerun"))]
     if args.rrd {
         bail!("--rrd needs a build with the rerun feature: cargo build --release -p pipeline --features rerun");
     }
-    let (calib, world, origin) = rendered_world(&args.images)?;
-    let (known, landmark_rocks) = run_of(&args.run, &world, &args.images)?;
-    let rng_estimate = estimate(&known.map).expect("EDC has a lune");
-    let graph = RouteGraph::new(known.map.landmarks(), &rng_estimate);
+    let closed = ClosedLoop::load(&args.images, &args.run)?;
+    let terrain = closed.terrain();
+    let ClosedLoop {
+        world,
+        origin,
+        known,
+        landmark_rocks,
+        rng_estimate,
+        graph,
+        ..
+    } = &closed;
     let goals: Vec<LandmarkId> = landmark_rocks.keys().copied().collect();
     if goals.is_empty() {
         bail!("the run's map has no landmark standing for a rock: nothing to drive to");
     }
-    let terrain = Terrain {
-        world: &world,
-        calib: &calib,
-        landmark_rocks: &landmark_rocks,
-    };
-    let driving = Driving {
-        step_m: args.step,
-        max_steps: args.max_steps,
-        cost: RouteCost {
-            lambda: args.lambda,
-        },
-    };
     let settings = RunSettings::default();
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
-    let (low, high) = extent(&world);
-    if !(low.x < high.x && low.y < high.y) {
-        bail!(
-            "{}: the rocks span too little ground to draw starts among them",
-            args.images.display()
-        );
-    }
     let bar = ProgressBar::new(args.trips as u64);
     bar.set_style(
         ProgressStyle::with_template(
@@ -115,37 +163,14 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     let mut trips = Vec::new();
     let mut shared_goal = None;
     for k in 0..args.trips {
-        let mut attempts = 0;
-        let start = loop {
-            attempts += 1;
-            if attempts > 10_000 {
-                bail!(
-                    "{}: no start point clear of the rocks in 10 000 draws",
-                    args.images.display()
-                );
-            }
-            let p = Point::new(
-                rng.random_range(low.x..high.x),
-                rng.random_range(low.y..high.y),
-            );
-            let clear = world
-                .rocks
-                .iter()
-                .all(|r| r.position.distance(p) > world.contact_radius(r.id) + 2.0 * CLEARANCE_M);
-            if clear {
-                break Pose {
-                    position: p,
-                    heading: rng.random_range(0.0..TAU),
-                };
-            }
-        };
+        let start = random_start(world, &mut rng, &args.images)?;
         let goal = match (k < 3, shared_goal) {
             (true, Some(goal)) => goal,
             _ => goals[rng.random_range(0..goals.len())],
         };
         shared_goal.get_or_insert(goal);
         trips.push(drive(
-            &terrain, &known, &graph, &settings, start, goal, &driving,
+            &terrain, known, graph, &settings, start, goal, &driving,
         ));
         bar.inc(1);
     }
@@ -165,7 +190,22 @@ pub fn run(args: &DriveArgs) -> Result<()> {
             .stage_bytes(&path, (json + "\n").as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let picture = figure(&world, &landmark_rocks, &rng_estimate, &trips);
+    let picture = figure(
+        world,
+        landmark_rocks,
+        rng_estimate,
+        &trips,
+        trips[0].goal,
+        Grid {
+            arrow_length: 1.0,
+            ..Grid::default()
+        },
+        format!(
+            "Closed loop through rendered panoramas: {} trips to landmark {}",
+            trips.len().min(3),
+            trips[0].goal
+        ),
+    );
     outputs.stage(&args.out.join("drive.png"), |temporary| {
         write_flow(temporary, &picture)
     })?;
@@ -217,6 +257,42 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     Ok(())
 }
 
+/// A random pose among the rocks, clear of them (twice the hazard clearance from every
+/// footprint), facing a random way: a trip's start.
+pub(super) fn random_start(world: &World, rng: &mut ChaCha8Rng, images: &Path) -> Result<Pose> {
+    let (low, high) = extent(world);
+    if !(low.x < high.x && low.y < high.y) {
+        bail!(
+            "{}: the rocks span too little ground to draw starts among them",
+            images.display()
+        );
+    }
+    for _ in 0..10_000 {
+        let p = Point::new(
+            rng.random_range(low.x..high.x),
+            rng.random_range(low.y..high.y),
+        );
+        if clear_of_rocks(world, p) {
+            return Ok(Pose {
+                position: p,
+                heading: rng.random_range(0.0..TAU),
+            });
+        }
+    }
+    bail!(
+        "{}: no start point clear of the rocks in 10 000 draws",
+        images.display()
+    )
+}
+
+/// Whether `p` lies at least twice the hazard clearance from every rock's footprint.
+pub(super) fn clear_of_rocks(world: &World, p: Point) -> bool {
+    world
+        .rocks
+        .iter()
+        .all(|r| r.position.distance(p) > world.contact_radius(r.id) + 2.0 * CLEARANCE_M)
+}
+
 /// The box the rocks lie in, shrunk by a metre: where starts are drawn.
 fn extent(world: &World) -> (Point, Point) {
     let (low, high) = bounds(world.rocks.iter().map(|r| r.position));
@@ -227,7 +303,7 @@ fn extent(world: &World) -> (Point, Point) {
 }
 
 /// The smallest box holding `points`, as its lower and upper corners.
-fn bounds(points: impl Iterator<Item = Point>) -> (Point, Point) {
+pub(super) fn bounds(points: impl Iterator<Item = Point>) -> (Point, Point) {
     points.fold(
         (
             Point::new(f64::INFINITY, f64::INFINITY),
@@ -307,13 +383,28 @@ fn summarize(trips: &[Trip]) -> serde_json::Value {
     })
 }
 
-/// drive.png: the map's landmarks at their rocks' positions, the RNG estimate, Voronoi
-/// borders, and the first three trips (one shared goal), as 000 Fig. 6.
-fn figure(
+/// What the navigator decided at the points of a grid (`navigate flowfield`), world
+/// coordinates: a heading (unit vector), arrived, or no heading.
+#[derive(Debug, Default)]
+pub(super) struct Grid {
+    pub arrows: Vec<(Point, (f64, f64))>,
+    /// Metres, drawn; a fraction of the grid's spacing.
+    pub arrow_length: f64,
+    pub arrived: Vec<Point>,
+    pub undecided: Vec<Point>,
+}
+
+/// 000 Fig. 6 over the rendered world: the map's landmarks at their rocks' positions, the RNG
+/// estimate, Voronoi borders, the navigator's decisions over a grid, and the first three trips
+/// (one shared goal).
+pub(super) fn figure(
     world: &World,
     landmark_rocks: &BTreeMap<LandmarkId, u32>,
     rng: &RngEstimate,
     trips: &[Trip],
+    goal: LandmarkId,
+    grid: Grid,
+    title: String,
 ) -> FlowPicture {
     let ids: Vec<LandmarkId> = landmark_rocks.keys().copied().collect();
     let raw: Vec<Point> = landmark_rocks
@@ -322,11 +413,16 @@ fn figure(
         .collect();
     let shown: Vec<&Trip> = trips.iter().take(3).collect();
     let (low, high) = bounds(
-        raw.iter().copied().chain(
-            shown
-                .iter()
-                .flat_map(|t| t.path.iter().map(|p| Point::new(p[0], p[1]))),
-        ),
+        raw.iter()
+            .copied()
+            .chain(
+                shown
+                    .iter()
+                    .flat_map(|t| t.path.iter().map(|p| Point::new(p[0], p[1]))),
+            )
+            .chain(grid.arrows.iter().map(|a| a.0))
+            .chain(grid.arrived.iter().copied())
+            .chain(grid.undecided.iter().copied()),
     );
     let (x0, y0, x1, y1) = (low.x, low.y, high.x, high.y);
     let shift = |x: f64, y: f64| (x - x0 + 1.0, y - y0 + 1.0);
@@ -337,21 +433,33 @@ fn figure(
         .iter()
         .filter_map(|e| Some((index(e.a)?, index(e.b)?, e.cost)))
         .collect();
-    let goal = shown
-        .first()
-        .and_then(|t| landmark_rocks.get(&t.goal))
-        .map(|&r| world.rocks[r as usize].position)
-        .unwrap_or(raw[0]);
+    let goal = landmark_rocks
+        .get(&goal)
+        .map_or(raw[0], |&r| world.rocks[r as usize].position);
+    let shifted = |points: Vec<Point>| points.iter().map(|p| shift(p.x, p.y)).collect();
     FlowPicture {
-        title: format!(
-            "Closed loop through rendered panoramas: {} trips to landmark {}",
-            shown.len(),
-            shown.first().map_or(0, |t| t.goal)
-        ),
+        title,
         landmarks: raw.iter().map(|p| shift(p.x, p.y)).collect(),
         edges,
         true_edges: true_rng(&raw),
-        arrows: Vec::new(),
+        arrows: grid
+            .arrows
+            .iter()
+            .map(|&(p, direction)| (shift(p.x, p.y), direction))
+            .collect(),
+        arrow_length: grid.arrow_length,
+        rocks: world
+            .rocks
+            .iter()
+            .map(|r| {
+                (
+                    shift(r.position.x, r.position.y),
+                    world.contact_radius(r.id),
+                )
+            })
+            .collect(),
+        arrived: shifted(grid.arrived),
+        undecided: shifted(grid.undecided),
         goal: shift(goal.x, goal.y),
         trips: shown
             .iter()

@@ -3,6 +3,7 @@
 pub mod directions;
 pub mod drive;
 pub mod eval;
+pub mod flowfield;
 pub mod locate;
 pub mod map;
 pub mod measure;

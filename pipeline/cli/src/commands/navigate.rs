@@ -17,7 +17,7 @@ use qrm_core::simulation::{
     drive, nearest, Controller, Drive, Layout, NavigationStudy, NavigationSummary, RngSource,
     Sensor, TripRecord,
 };
-use qrm_plot::{write_flow, FlowPicture};
+use qrm_plot::{write_flow, write_panels, Curve, FlowPicture, Panel};
 use rand::SeedableRng;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -51,6 +51,13 @@ pub enum NavigateCommand {
     /// trips.json, summary.json and drive.png (000 Fig. 6 with the first three trips), e.g.
     /// `navigate drive --images data/marsyard --run marsyard-run --trips 20`.
     Drive(super::drive::DriveArgs),
+    /// 000 Fig. 6 for the closed loop: at every point of a grid over a synthetic dataset's
+    /// world, the heading the navigator of `navigate drive` picks from the stereo panorama
+    /// rendered there toward a goal landmark's cell (its first step, from the panorama alone),
+    /// with the run's RNG estimate, the Voronoi borders and three closed-loop trips to the goal.
+    /// Writes flowfield.png/.svg, headings.csv and trips.json, e.g. `navigate flowfield
+    /// --images data/marsyard --run marsyard-run --goal 10`.
+    Flowfield(super::flowfield::FlowfieldArgs),
     /// Route directions (docs/DIRECTIONS.md) followed through panoramas rendered in a synthetic
     /// dataset's world: routes planned on the map of a `pipeline run` over it, each leg's
     /// target picked as the most isolated of the rover's own detections; predicted route
@@ -116,9 +123,11 @@ pub struct SimulateArgs {
     #[arg(long, default_value_t = 0.3)]
     jitter: f64,
     /// Plan on the RNG estimated from an EDC map of this many simulated panoramas (exact
-    /// sensing) instead of the true RNG.
-    #[arg(long)]
-    images: Option<usize>,
+    /// sensing) instead of the true RNG. Several (`--images 5,10,20,50`) run a sweep: the
+    /// study once per number of images (and per `--lambda`), with sweep.csv and a figure of
+    /// success, re-plans and path length against the images mapped (sweep.png/.svg).
+    #[arg(long, value_delimiter = ',')]
+    images: Vec<usize>,
     /// Landmarks each mapping panorama sees (the n nearest; default all).
     #[arg(long)]
     nearest: Option<usize>,
@@ -126,9 +135,10 @@ pub struct SimulateArgs {
     /// case: "landmarks visible from adjacent cells").
     #[arg(long)]
     visible: Option<usize>,
-    /// Weight λ of an edge's RNG cost against one hop.
-    #[arg(long, default_value_t = 1.0)]
-    lambda: f64,
+    /// Weight λ of an edge's RNG cost against one hop; several (`--lambda 0,10`) compare them
+    /// in a sweep, one curve each.
+    #[arg(long, value_delimiter = ',', default_values_t = [1.0])]
+    lambda: Vec<f64>,
     /// Step length, as a fraction of the side (seed digest A.7: 0.5 %).
     #[arg(long, default_value_t = 0.005)]
     step: f64,
@@ -158,6 +168,7 @@ pub fn run_command(command: NavigateCommand) -> Result<()> {
         NavigateCommand::Simulate(args) => simulate(&args),
         NavigateCommand::Locate(args) => super::locate::locate(&args),
         NavigateCommand::Drive(args) => super::drive::run(&args),
+        NavigateCommand::Flowfield(args) => super::flowfield::run(&args),
         NavigateCommand::Directions(args) => super::directions::trial(&args),
     }
 }
@@ -234,7 +245,9 @@ fn hull<C: Calculus>(map: &Hypergraph<C>) -> Result<()> {
     Ok(())
 }
 
-fn study(args: &SimulateArgs) -> Result<NavigationStudy> {
+/// The study of `args` planning on the RNG after `images` mapped panoramas (`None`: the true
+/// RNG) with edge weight `lambda`.
+fn study(args: &SimulateArgs, images: Option<usize>, lambda: f64) -> Result<NavigationStudy> {
     if args.worlds == 0 || args.pairs == 0 {
         bail!("--worlds and --pairs must be positive");
     }
@@ -253,8 +266,8 @@ fn study(args: &SimulateArgs) -> Result<NavigationStudy> {
     if !(0.0..0.5).contains(&args.jitter) {
         bail!("--jitter {} must lie in [0, 0.5)", args.jitter);
     }
-    if !(args.lambda >= 0.0 && args.lambda.is_finite()) {
-        bail!("--lambda {} must be a finite number ≥ 0", args.lambda);
+    if !(lambda >= 0.0 && lambda.is_finite()) {
+        bail!("--lambda {lambda} must be a finite number ≥ 0");
     }
     if args.nearest.is_some_and(|n| n < 3) || args.visible.is_some_and(|n| n < 1) {
         bail!("--nearest must be at least 3 and --visible at least 1");
@@ -271,7 +284,7 @@ fn study(args: &SimulateArgs) -> Result<NavigationStudy> {
                 jitter: args.jitter,
             },
         },
-        source: match args.images {
+        source: match images {
             None => RngSource::True,
             Some(images) => RngSource::Mapped {
                 images,
@@ -284,9 +297,7 @@ fn study(args: &SimulateArgs) -> Result<NavigationStudy> {
             max_steps: (10.0 * std::f64::consts::SQRT_2 / args.step).ceil() as usize,
             max_replans: 5,
             sensor: Sensor::exact(args.visible),
-            cost: RouteCost {
-                lambda: args.lambda,
-            },
+            cost: RouteCost { lambda },
             controller: match args.controller {
                 ControllerName::Legs => Controller::Legs,
                 ControllerName::Flow => Controller::Flow,
@@ -297,7 +308,28 @@ fn study(args: &SimulateArgs) -> Result<NavigationStudy> {
 }
 
 fn simulate(args: &SimulateArgs) -> Result<()> {
-    let study = study(args)?;
+    let images: Vec<Option<usize>> = if args.images.is_empty() {
+        vec![None]
+    } else {
+        args.images.iter().map(|&k| Some(k)).collect()
+    };
+    if args.lambda.is_empty() {
+        bail!("--lambda needs a value");
+    }
+    let settings: Vec<(Option<usize>, f64)> = images
+        .iter()
+        .flat_map(|&k| args.lambda.iter().map(move |&lambda| (k, lambda)))
+        .collect();
+    match settings.as_slice() {
+        [(images, lambda)] => simulate_one(args, study(args, *images, *lambda)?),
+        _ if args.images.is_empty() => bail!(
+            "a sweep draws its figures against the images mapped: give --images k1,k2,… with several --lambda values"
+        ),
+        _ => sweep(args, &settings),
+    }
+}
+
+fn simulate_one(args: &SimulateArgs, study: NavigationStudy) -> Result<()> {
     let bar = ProgressBar::new(study.worlds as u64);
     bar.set_style(
         ProgressStyle::with_template(
@@ -311,7 +343,10 @@ fn simulate(args: &SimulateArgs) -> Result<()> {
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     let summary = NavigationSummary::of(&records);
-    write_atomic(&args.out.join("trips.csv"), trips_csv(&records).as_bytes())?;
+    write_atomic(
+        &args.out.join("trips.csv"),
+        trips_csv(&[(&study, records.as_slice())]).as_bytes(),
+    )?;
     let json = serde_json::json!({
         "format": "qrm-navigation-study",
         "version": 1,
@@ -344,26 +379,214 @@ fn simulate(args: &SimulateArgs) -> Result<()> {
     Ok(())
 }
 
-fn trips_csv(records: &[TripRecord]) -> String {
-    let mut out = String::from(
-        "world,pair,outcome,length_ratio,length,straight,route_hops,legs,replans,steps\n",
+/// One study of a sweep: its setting, trips and summary, and its wall time.
+struct Setting {
+    study: NavigationStudy,
+    records: Vec<TripRecord>,
+    summary: NavigationSummary,
+    seconds: f64,
+}
+
+/// The study once per (images, λ) in `settings`: trips.csv, summary.json, sweep.csv and
+/// sweep.png/.svg (success, re-plans and path length against the images mapped, a curve per
+/// λ; docs/NAVIGATION.md).
+fn sweep(args: &SimulateArgs, settings: &[(Option<usize>, f64)]) -> Result<()> {
+    let studies: Vec<NavigationStudy> = settings
+        .iter()
+        .map(|&(images, lambda)| study(args, images, lambda))
+        .collect::<Result<_>>()?;
+    let bar = ProgressBar::new((studies.len() * args.worlds) as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} fields [{bar:40}] {pos}/{len} over all settings ({elapsed}, eta {eta})",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
     );
-    for r in records {
-        let outcome = serde_json::to_value(r.outcome).expect("outcome serialises");
+    let done: Vec<Setting> = studies
+        .into_iter()
+        .map(|study| {
+            let start = Instant::now();
+            let records = study.run(&|| bar.inc(1));
+            Setting {
+                summary: NavigationSummary::of(&records),
+                seconds: start.elapsed().as_secs_f64(),
+                study,
+                records,
+            }
+        })
+        .collect();
+    bar.finish_and_clear();
+    let runs: Vec<(&NavigationStudy, &[TripRecord])> = done
+        .iter()
+        .map(|s| (&s.study, s.records.as_slice()))
+        .collect();
+    write_atomic(&args.out.join("trips.csv"), trips_csv(&runs).as_bytes())?;
+    write_atomic(&args.out.join("sweep.csv"), sweep_csv(&done).as_bytes())?;
+    let first = &done[0].study;
+    let json = serde_json::json!({
+        "format": "qrm-navigation-sweep",
+        "version": 1,
+        "worlds": first.worlds,
+        "landmarks": first.landmarks,
+        "pairs": first.pairs,
+        "side": first.side,
+        "layout": first.layout,
+        "controller": first.drive.controller,
+        "step": first.drive.step,
+        "visible": args.visible,
+        "seed": first.seed,
+        "settings": done.iter().map(|s| serde_json::json!({
+            "rng": s.study.source,
+            "lambda": s.study.drive.cost.lambda,
+            "seconds": s.seconds,
+            "summary": s.summary,
+        })).collect::<Vec<_>>(),
+    });
+    write_atomic(
+        &args.out.join("summary.json"),
+        (serde_json::to_string_pretty(&json).expect("JSON values serialise") + "\n").as_bytes(),
+    )?;
+    let panels = sweep_panels(&done);
+    for name in ["sweep.png", "sweep.svg"] {
+        write_panels(&args.out.join(name), "images mapped (k)", &panels)?;
+    }
+    print!("{}", sweep_text(&done, args));
+    println!(
+        "wrote {}/trips.csv, sweep.csv, summary.json, sweep.png, sweep.svg",
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The images a study's map was built from (`None`: the true RNG).
+fn images_of(study: &NavigationStudy) -> Option<usize> {
+    match study.source {
+        RngSource::True => None,
+        RngSource::Mapped { images, .. } => Some(images),
+    }
+}
+
+/// sweep.csv: one row per setting.
+fn sweep_csv(done: &[Setting]) -> String {
+    let mut out = String::from(
+        "images,lambda,trips,success,mean_replans,mean_legs,median_length_ratio,p90_length_ratio\n",
+    );
+    for s in done {
+        let m = &s.summary;
         let _ = writeln!(
             out,
-            "{},{},{},{:.4},{:.3},{:.3},{},{},{},{}",
-            r.world,
-            r.pair,
-            outcome.as_str().unwrap_or("?"),
-            r.length_ratio,
-            r.length,
-            r.straight,
-            r.route_hops,
-            r.legs,
-            r.replans,
-            r.steps
+            "{},{},{},{:.4},{:.3},{:.3},{:.4},{:.4}",
+            images_of(&s.study).map_or(String::new(), |k| k.to_string()),
+            s.study.drive.cost.lambda,
+            m.trips,
+            m.success_rate,
+            m.mean_replans,
+            m.mean_legs,
+            m.median_length_ratio,
+            m.p90_length_ratio
         );
+    }
+    out
+}
+
+/// Success, re-plans and path length against the images mapped, a curve per λ (the layout of
+/// 000 Fig. 7's panels).
+fn sweep_panels(done: &[Setting]) -> Vec<Panel> {
+    let mut xs: Vec<usize> = done.iter().filter_map(|s| images_of(&s.study)).collect();
+    xs.sort_unstable();
+    xs.dedup();
+    let mut lambdas: Vec<f64> = done.iter().map(|s| s.study.drive.cost.lambda).collect();
+    lambdas.sort_by(f64::total_cmp);
+    lambdas.dedup();
+    let panel = |title: &str, y_label: &str, metric: &dyn Fn(&NavigationSummary) -> f64| Panel {
+        title: title.into(),
+        y_label: y_label.into(),
+        x: xs.iter().map(|&k| k as f64).collect(),
+        curves: lambdas
+            .iter()
+            .map(|&lambda| Curve {
+                label: format!("λ = {lambda}"),
+                mean: xs
+                    .iter()
+                    .map(|&k| {
+                        done.iter()
+                            .find(|s| {
+                                images_of(&s.study) == Some(k)
+                                    && s.study.drive.cost.lambda == lambda
+                            })
+                            .map_or(f64::NAN, |s| metric(&s.summary))
+                    })
+                    .collect(),
+                std: Vec::new(),
+                band: None,
+            })
+            .collect(),
+    };
+    vec![
+        panel("(a) trips that arrive", "success (%)", &|m| {
+            100.0 * m.success_rate
+        }),
+        panel("(b) re-plans", "mean re-plans per trip", &|m| {
+            m.mean_replans
+        }),
+        panel(
+            "(c) path length, trips that arrive",
+            "median path / straight distance",
+            &|m| m.median_length_ratio,
+        ),
+    ]
+}
+
+fn sweep_text(done: &[Setting], args: &SimulateArgs) -> String {
+    let mut out = format!(
+        "{} worlds × {} pairs per setting, {} landmarks, rover sees {}:\n  images  λ      success  re-plans  length ratio (median)\n",
+        args.worlds,
+        args.pairs,
+        args.landmarks,
+        args.visible
+            .map_or("all".to_string(), |n| format!("the {n} nearest")),
+    );
+    for s in done {
+        let _ = writeln!(
+            out,
+            "  {:>6}  {:<5}  {:>6.1} %  {:>8.2}  {:.3}",
+            images_of(&s.study).map_or("true".to_string(), |k| k.to_string()),
+            s.study.drive.cost.lambda,
+            100.0 * s.summary.success_rate,
+            s.summary.mean_replans,
+            s.summary.median_length_ratio
+        );
+    }
+    out
+}
+
+/// trips.csv: one row per trip of each study, with the images its map was built from (empty:
+/// the true RNG) and λ.
+fn trips_csv(runs: &[(&NavigationStudy, &[TripRecord])]) -> String {
+    let mut out = String::from(
+        "images,lambda,world,pair,outcome,length_ratio,length,straight,route_hops,legs,replans,steps\n",
+    );
+    for (study, records) in runs {
+        let images = images_of(study).map_or(String::new(), |k| k.to_string());
+        for r in records.iter() {
+            let outcome = serde_json::to_value(r.outcome).expect("outcome serialises");
+            let _ = writeln!(
+                out,
+                "{images},{},{},{},{},{:.4},{:.3},{:.3},{},{},{},{}",
+                study.drive.cost.lambda,
+                r.world,
+                r.pair,
+                outcome.as_str().unwrap_or("?"),
+                r.length_ratio,
+                r.length,
+                r.straight,
+                r.route_hops,
+                r.legs,
+                r.replans,
+                r.steps
+            );
+        }
     }
     out
 }
@@ -443,6 +666,10 @@ fn flow_picture(study: &NavigationStudy) -> Result<FlowPicture> {
         edges,
         true_edges,
         arrows,
+        arrow_length: 0.02 * study.side,
+        rocks: Vec::new(),
+        arrived: Vec::new(),
+        undecided: Vec::new(),
         goal: (goal.x, goal.y),
         trips,
         side: study.side,
@@ -498,12 +725,62 @@ mod tests {
             replans: 0,
             steps: 100,
         }];
-        let csv = trips_csv(&records);
+        let args = simulate_args(&["--images", "5", "--lambda", "10"]);
+        let study = study(&args, Some(5), 10.0).unwrap();
+        let csv = trips_csv(&[(&study, &records)]);
         assert_eq!(csv.lines().count(), 2);
         assert!(csv
             .lines()
             .nth(1)
             .unwrap()
-            .starts_with("0,3,arrived,1.2500,"));
+            .starts_with("5,10,0,3,arrived,1.2500,"));
+    }
+
+    /// `navigate simulate` with `flags`.
+    fn simulate_args(flags: &[&str]) -> SimulateArgs {
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            args: SimulateArgs,
+        }
+        <Cli as clap::Parser>::parse_from(std::iter::once("simulate").chain(flags.iter().copied()))
+            .args
+    }
+
+    /// A sweep's table and figure hold one point per images mapped and one curve per λ, in
+    /// the order of the images.
+    #[test]
+    fn a_sweep_has_a_curve_per_lambda_over_the_images() {
+        let args = simulate_args(&[
+            "--worlds", "2", "--pairs", "5", "--images", "10,5", "--lambda", "0,10",
+        ]);
+        let done: Vec<Setting> = [(10, 0.0), (10, 10.0), (5, 0.0), (5, 10.0)]
+            .into_iter()
+            .map(|(k, lambda)| {
+                let study = study(&args, Some(k), lambda).unwrap();
+                let records = study.run(&|| ());
+                Setting {
+                    summary: NavigationSummary::of(&records),
+                    seconds: 0.0,
+                    study,
+                    records,
+                }
+            })
+            .collect();
+        let csv = sweep_csv(&done);
+        assert_eq!(csv.lines().count(), 5);
+        assert!(csv.lines().nth(3).unwrap().starts_with("5,0,10,"));
+        let panels = sweep_panels(&done);
+        assert_eq!(panels.len(), 3);
+        for panel in &panels {
+            assert_eq!(panel.x, [5.0, 10.0]);
+            let labels: Vec<&str> = panel.curves.iter().map(|c| c.label.as_str()).collect();
+            assert_eq!(labels, ["λ = 0", "λ = 10"]);
+        }
+        // Success at k = 5, λ = 0 is the third setting's.
+        assert_eq!(
+            panels[0].curves[0].mean[0],
+            100.0 * done[2].summary.success_rate
+        );
     }
 }
