@@ -327,9 +327,18 @@ fn drives_through_the_rendered_world_without_seeing_it() {
             out.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        for file in ["trips.json", "summary.json", "drive.png", "drive.mcap"] {
+        for file in [
+            "trips.json",
+            "trips.csv",
+            "summary.json",
+            "drive.png",
+            "drive.mcap",
+        ] {
             assert!(out.join(file).is_file(), "{file}");
         }
+        let csv = std::fs::read_to_string(out.join("trips.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 3, "{csv}");
+        assert!(csv.starts_with("trip,start_x,start_y,goal,outcome,"));
         let trips: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("trips.json")).unwrap())
                 .unwrap();

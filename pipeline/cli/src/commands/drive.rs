@@ -26,6 +26,7 @@ use rand_chacha::ChaCha8Rng;
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
+use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -49,7 +50,8 @@ pub struct DriveArgs {
     /// Also write OUT/drive.rrd for the rerun viewer (needs a build with `--features rerun`).
     #[arg(long)]
     rrd: bool,
-    /// Output directory: trips.json, summary.json, drive.png, drive.mcap (every step).
+    /// Output directory: trips.json, trips.csv, summary.json, drive.png, drive.mcap (every
+    /// step).
     #[arg(long, default_value = "drive")]
     out: PathBuf,
 }
@@ -179,15 +181,19 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let summary = summarize(&trips);
-    // The three files replace an earlier drive's together.
+    // The files replace an earlier drive's together.
     let mut outputs = OutputSet::new();
-    for (name, json) in [
-        ("trips.json", serde_json::to_string_pretty(&trips)?),
-        ("summary.json", serde_json::to_string_pretty(&summary)?),
+    for (name, text) in [
+        ("trips.json", serde_json::to_string_pretty(&trips)? + "\n"),
+        ("trips.csv", trips_csv(&trips)),
+        (
+            "summary.json",
+            serde_json::to_string_pretty(&summary)? + "\n",
+        ),
     ] {
         let path = args.out.join(name);
         outputs
-            .stage_bytes(&path, (json + "\n").as_bytes())
+            .stage_bytes(&path, text.as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     let picture = figure(
@@ -247,7 +253,7 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     );
     println!("{}", serde_json::to_string_pretty(&summary)?);
     println!(
-        "wrote {}, {}, {} and {} (every step, topic {})",
+        "wrote {}, trips.csv, {}, {} and {} (every step, topic {})",
         args.out.join("trips.json").display(),
         args.out.join("summary.json").display(),
         args.out.join("drive.png").display(),
@@ -316,6 +322,38 @@ pub(super) fn bounds(points: impl Iterator<Item = Point>) -> (Point, Point) {
             )
         },
     )
+}
+
+/// trips.csv: one row per trip (docs/NAVIGATION.md): the statistics of trips.json without
+/// the paths and steps.
+fn trips_csv(trips: &[Trip]) -> String {
+    let mut csv = String::from(
+        "trip,start_x,start_y,goal,outcome,in_goal_cell,steps,replans,collisions,avoided,length_m,straight_m,reference_m,navigator_median_s,navigator_max_s\n",
+    );
+    for (k, t) in trips.iter().enumerate() {
+        let mut seconds = t.navigator_seconds.clone();
+        seconds.sort_by(f64::total_cmp);
+        let outcome = serde_json::to_value(t.outcome).expect("outcome serialises");
+        let _ = writeln!(
+            csv,
+            "{k},{:.3},{:.3},{},{},{},{},{},{},{},{:.3},{:.3},{},{:.4},{:.4}",
+            t.start[0],
+            t.start[1],
+            t.goal,
+            outcome.as_str().unwrap_or("?"),
+            t.in_goal_cell,
+            t.navigator_seconds.len(),
+            t.replans,
+            t.collisions,
+            t.avoided,
+            t.length_m,
+            t.straight_m,
+            t.reference_m.map_or(String::new(), |r| format!("{r:.3}")),
+            quantile(&seconds, 0.5),
+            quantile(&seconds, 1.0)
+        );
+    }
+    csv
 }
 
 /// Success, collisions, steps, re-plans, path length and navigator time over the trips.
