@@ -35,8 +35,8 @@ pub struct FlowfieldArgs {
     #[arg(long)]
     goal: LandmarkId,
     /// Grid points per side, over the box the map's landmarks' rocks lie in, grown by a metre.
-    /// Each point costs a rendered stereo panorama and a navigator step (about 1 s at 4096 ×
-    /// 768 on 2 cores, 0.3 s at half resolution).
+    /// Each point costs a rendered stereo panorama and a navigator step: 4 min for the 112
+    /// points and 3 trips of a 4096 × 768 marsyard set on 2 cores, 1 min at half resolution.
     #[arg(long, default_value_t = 12)]
     grid: usize,
     /// Closed-loop trips to the goal from random starts, drawn as trajectories.
