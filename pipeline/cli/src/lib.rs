@@ -81,8 +81,9 @@ pub enum Command {
     /// Inspect or merge saved maps (JSON, docs/MAP_FORMAT.md).
     #[command(subcommand)]
     Map(commands::map::MapCommand),
-    /// Navigate over a map's RNG (000 §VII-B): landmark routes, the convex hull, and simulated
-    /// navigation with an ideal sensor (docs/NAVIGATION.md).
+    /// Navigate over a map's RNG (000 §VII-B): landmark routes and the convex hull, which cell a
+    /// panorama was taken in, closed-loop trips through rendered panoramas and their flow field,
+    /// and simulated navigation with an ideal sensor (docs/NAVIGATION.md).
     #[command(subcommand)]
     Navigate(commands::navigate::NavigateCommand),
     /// Route directions a person or rover can follow (004 Park & Kender) from a run's map:

@@ -6,7 +6,6 @@
 //! (docs/NAVIGATION.md, "The flow field of the closed loop").
 
 use super::drive::{clear_of_rocks, figure, random_start, ClosedLoop, DrivingArgs, Grid};
-use super::output::write_atomic;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -15,11 +14,12 @@ use qrm_core::geometry::Point;
 use qrm_core::map::LandmarkId;
 use qrm_plot::write_flow;
 use qrm_synth::closed_loop::{drive, Driving, Trip};
-use qrm_synth::Pose;
+use qrm_synth::{Pose, World};
 use qrm_vision::run::RunSettings;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::PathBuf;
 
@@ -175,23 +175,25 @@ pub fn run(args: &FlowfieldArgs) -> Result<()> {
     );
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
+    // The four files replace an earlier run's together.
     let mut outputs = OutputSet::new();
     for name in ["flowfield.png", "flowfield.svg"] {
         outputs.stage(&args.out.join(name), |temporary| {
             write_flow(temporary, &picture)
         })?;
     }
+    for (name, text) in [
+        ("headings.csv", headings_csv(&headings)),
+        ("trips.json", serde_json::to_string_pretty(&trips)? + "\n"),
+    ] {
+        let path = args.out.join(name);
+        outputs
+            .stage_bytes(&path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     outputs
         .commit()
-        .with_context(|| format!("cannot move the figures into {}", args.out.display()))?;
-    write_atomic(
-        &args.out.join("headings.csv"),
-        headings_csv(&headings).as_bytes(),
-    )?;
-    write_atomic(
-        &args.out.join("trips.json"),
-        (serde_json::to_string_pretty(&trips)? + "\n").as_bytes(),
-    )?;
+        .with_context(|| format!("cannot move the outputs into {}", args.out.display()))?;
     let in_goal = trips.iter().filter(|t| t.in_goal_cell).count();
     println!(
         "{} grid points in {} ({}), map of {} landmarks from {}: {} headings, {} arrived, {} without a heading; {} of {} trips ended in the goal's cell",
@@ -217,8 +219,8 @@ pub fn run(args: &FlowfieldArgs) -> Result<()> {
 /// metre, that are clear of every rock (a rover cannot stand inside one), and the grid's
 /// smaller spacing.
 fn grid_points(
-    world: &qrm_synth::World,
-    landmark_rocks: &std::collections::BTreeMap<LandmarkId, u32>,
+    world: &World,
+    landmark_rocks: &BTreeMap<LandmarkId, u32>,
     side: usize,
 ) -> (Vec<Point>, f64) {
     let (low, high) = super::drive::bounds(
@@ -241,8 +243,8 @@ fn grid_points(
 
 /// The landmark whose rock is nearest to `p` (the truth, for the CSV only).
 fn true_cell(
-    world: &qrm_synth::World,
-    landmark_rocks: &std::collections::BTreeMap<LandmarkId, u32>,
+    world: &World,
+    landmark_rocks: &BTreeMap<LandmarkId, u32>,
     p: Point,
 ) -> Option<LandmarkId> {
     landmark_rocks

@@ -48,8 +48,9 @@ pub enum NavigateCommand {
     /// stereo panorama is rendered at the rover's pose, detected, associated with the map of a
     /// `pipeline run` over that dataset, and the leg follower picks the heading; rocks are
     /// obstacles (a hazard avoidance drives each step around the rocks within 4 m). Writes
-    /// trips.json, summary.json and drive.png (000 Fig. 6 with the first three trips), e.g.
-    /// `navigate drive --images data/marsyard --run marsyard-run --trips 20`.
+    /// trips.json, trips.csv, summary.json, drive.png (000 Fig. 6 with the first three trips)
+    /// and drive.mcap (every step), e.g. `navigate drive --images data/marsyard --run
+    /// marsyard-run --trips 20`.
     Drive(super::drive::DriveArgs),
     /// 000 Fig. 6 for the closed loop: at every point of a grid over a synthetic dataset's
     /// world, the heading the navigator of `navigate drive` picks from the stereo panorama
@@ -67,7 +68,9 @@ pub enum NavigateCommand {
     /// Simulated navigation with an ideal sensor (bearings and range order of the landmarks,
     /// no rendering): random fields, random start/goal pairs, the leg follower of 000 §VII-B
     /// planning on the true RNG or on the RNG of a map after `--images` simulated panoramas.
-    /// Writes trips.csv, summary.json and a figure like 000 Fig. 6 (flowfield.png/.svg).
+    /// Writes trips.csv, summary.json and a figure like 000 Fig. 6 (flowfield.png/.svg); with
+    /// several `--images` (and `--lambda`) values, a sweep: sweep.csv and sweep.png/.svg,
+    /// success, re-plans and path length against the images mapped.
     Simulate(SimulateArgs),
 }
 
