@@ -10,6 +10,11 @@
 //! it waits for a pass of renames under way to finish, then removes every temporary file still
 //! live, so that an interrupted process leaves the earlier outputs as they were and nothing
 //! half-written beside them.
+//!
+//! A target that exists and is not a regular file (`/dev/null`, a named pipe, a terminal) is
+//! not replaced: renaming over it would turn a device into a plain file (for `/dev/null`,
+//! breaking every later process that writes to it). Its content is staged in the system's
+//! temporary folder and copied into it at commit; such a target is written, not swapped.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -101,9 +106,18 @@ pub struct Temporary {
 }
 
 impl Temporary {
-    /// Names a fresh temporary file beside `target`; nothing is created yet.
+    /// Names a fresh temporary file beside `target` (in the system's temporary folder when
+    /// `target` is a device or pipe, see the crate documentation); nothing is created yet.
     pub fn beside(target: &Path) -> Self {
-        let path = temporary_path(target);
+        let path = if is_special(target) {
+            std::env::temp_dir().join(
+                temporary_path(target)
+                    .file_name()
+                    .expect("a temporary name has a file name"),
+            )
+        } else {
+            temporary_path(target)
+        };
         register(&path);
         Self {
             path,
@@ -136,7 +150,14 @@ impl Temporary {
     }
 
     fn rename(mut self) -> std::io::Result<()> {
-        std::fs::rename(&self.path, &self.target)?;
+        if is_special(&self.target) {
+            let mut content = std::fs::File::open(&self.path)?;
+            let mut target = std::fs::OpenOptions::new().write(true).open(&self.target)?;
+            std::io::copy(&mut content, &mut target)?;
+            std::fs::remove_file(&self.path)?;
+        } else {
+            std::fs::rename(&self.path, &self.target)?;
+        }
         self.committed = true;
         Ok(())
     }
@@ -221,6 +242,12 @@ pub fn write_bytes(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     write_via_temporary(path, |temporary| write_file(temporary, bytes), |e| e)
 }
 
+/// Whether `path` exists and is neither a regular file nor a folder (following links): a
+/// device, pipe or socket, which is written into rather than replaced.
+fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
 /// `.<name>.<pid>-<n>.tmp.<extension>` next to `path`.
 fn temporary_path(path: &Path) -> PathBuf {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
@@ -275,6 +302,32 @@ mod tests {
             .collect();
         names.sort();
         names
+    }
+
+    /// `--json /dev/null` once turned the machine's `/dev/null` into a plain file. A named
+    /// pipe takes the same path as a device, without risking the machine's `/dev/null`.
+    #[cfg(unix)]
+    #[test]
+    fn a_pipe_or_device_is_written_into_not_replaced() {
+        use std::os::unix::fs::FileTypeExt;
+        let scratch = tempfile::tempdir().unwrap();
+        let pipe = scratch.path().join("out.fifo");
+        let made = std::process::Command::new("mkfifo").arg(&pipe).status();
+        assert!(made.unwrap().success(), "mkfifo made the pipe");
+        let reader = |pipe: PathBuf| std::thread::spawn(move || std::fs::read(pipe).unwrap());
+        let read = reader(pipe.clone());
+        let is_pipe = || std::fs::metadata(&pipe).unwrap().file_type().is_fifo();
+        write_bytes(&pipe, b"through the pipe").unwrap();
+        // Checked before joining: a replaced pipe would leave the reader waiting.
+        assert!(is_pipe(), "the pipe was replaced by a file");
+        assert_eq!(read.join().unwrap(), b"through the pipe");
+        let read = reader(pipe.clone());
+        let mut set = OutputSet::new();
+        set.stage_bytes(&pipe, b"a set through the pipe").unwrap();
+        set.commit().unwrap();
+        assert!(is_pipe(), "the pipe was replaced by a file");
+        assert_eq!(read.join().unwrap(), b"a set through the pipe");
+        assert_eq!(names(scratch.path()), ["out.fifo"]);
     }
 
     #[test]
