@@ -239,19 +239,25 @@ impl Terrain<'_> {
         })
     }
 
-    /// Whether `p` lies in landmark `l`'s true cell: `l`'s rock is the nearest to `p` of the
-    /// map's landmarks' rocks. Two landmarks of one rock (a rock the map duplicated) share its
-    /// cell: judged by landmark, a rover at the rock was outside the cell of whichever of them
-    /// lost the tie (half-resolution marsyard seed 4: 6 trips to a duplicate landmark judged
-    /// beside their goal cell while at its rock).
-    fn in_true_cell(&self, p: Point, l: LandmarkId) -> bool {
-        let nearest = self
-            .landmark_rocks
-            .values()
-            .map(|&r| (r, self.world.rocks[r as usize].position.distance(p)))
+    /// The landmark whose true cell holds `p`: the one whose rock is the nearest to `p` of
+    /// the map's landmarks' rocks (judging only). Of two landmarks of one rock, the first.
+    pub fn true_cell(&self, p: Point) -> Option<LandmarkId> {
+        self.landmark_rocks
+            .iter()
+            .map(|(&l, &r)| (l, self.world.rocks[r as usize].position.distance(p)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(r, _)| r);
-        nearest.is_some() && nearest == self.landmark_rocks.get(&l).copied()
+            .map(|(l, _)| l)
+    }
+
+    /// Whether `p` lies in landmark `l`'s true cell ([`Terrain::true_cell`]). Two landmarks
+    /// of one rock (a rock the map duplicated) share its cell: judged by landmark, a rover at
+    /// the rock was outside the cell of whichever of them lost the tie (half-resolution
+    /// marsyard seed 4: 6 trips to a duplicate landmark judged beside their goal cell while at
+    /// its rock).
+    fn in_true_cell(&self, p: Point, l: LandmarkId) -> bool {
+        let rock = |l| self.landmark_rocks.get(&l).copied();
+        self.true_cell(p)
+            .is_some_and(|nearest| rock(nearest).is_some() && rock(nearest) == rock(l))
     }
 }
 

@@ -124,7 +124,7 @@ pub fn run(args: &FlowfieldArgs) -> Result<()> {
                 target: step.target,
                 bearing_deg: step.bearing_deg.map(|b| b + step.heading_deg),
                 cell: step.cell,
-                true_cell: true_cell(world, landmark_rocks, at),
+                true_cell: terrain.true_cell(at),
             }
         })
         .collect();
@@ -239,19 +239,6 @@ fn grid_points(
         .filter(|&p| clear_of_rocks(world, p))
         .collect();
     (points, dx.min(dy))
-}
-
-/// The landmark whose rock is nearest to `p` (the truth, for the CSV only).
-fn true_cell(
-    world: &World,
-    landmark_rocks: &BTreeMap<LandmarkId, u32>,
-    p: Point,
-) -> Option<LandmarkId> {
-    landmark_rocks
-        .iter()
-        .map(|(&l, &r)| (l, world.rocks[r as usize].position.distance(p)))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(l, _)| l)
 }
 
 /// headings.csv: one row per grid point (docs/NAVIGATION.md).
