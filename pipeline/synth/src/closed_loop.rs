@@ -137,6 +137,9 @@ pub enum Outcome {
 /// One trip: what the navigator did, and (from the truth, afterwards) how well.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Trip {
+    /// Its place in the seeded sequence of trips it was drawn from, from 0 (`navigate drive
+    /// --only` drives a few of them again); set by whoever draws the sequence, 0 otherwise.
+    pub number: usize,
     pub start: [f64; 2],
     pub goal: LandmarkId,
     pub outcome: Outcome,
@@ -272,6 +275,7 @@ pub fn drive(
     driving: &Driving,
 ) -> Trip {
     let mut trip = Trip {
+        number: 0,
         start: [start.position.x, start.position.y],
         goal,
         outcome: Outcome::OutOfSteps,

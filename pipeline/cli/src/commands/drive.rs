@@ -24,7 +24,7 @@ use qrm_vision::run::RunSettings;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::json;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::f64::consts::TAU;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -43,6 +43,11 @@ pub struct DriveArgs {
     /// their goal, for the figure).
     #[arg(long, default_value_t = 20)]
     trips: usize,
+    /// Drive only these trips of the seeded sequence (numbered from 0, as trips.csv numbers
+    /// them), each exactly as the whole drive would: to look again at a trip and its log,
+    /// e.g. `--trips 100 --only 41,57`.
+    #[arg(long, value_delimiter = ',')]
+    only: Vec<usize>,
     #[command(flatten)]
     driving: DrivingArgs,
     #[arg(long, default_value_t = 1)]
@@ -132,6 +137,13 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     if args.trips == 0 {
         bail!("--trips must be at least 1");
     }
+    if let Some(k) = args.only.iter().find(|&&k| k >= args.trips) {
+        bail!(
+            "--only {k}: the drive has trips 0 to {} (--trips {})",
+            args.trips - 1,
+            args.trips
+        );
+    }
     let driving = args.driving.driving()?;
     #[cfg(not(feature = "rerun"))]
     if args.rrd {
@@ -154,7 +166,13 @@ pub fn run(args: &DriveArgs) -> Result<()> {
     }
     let settings = RunSettings::default();
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
-    let bar = ProgressBar::new(args.trips as u64);
+    // The trips driven: all, or those `--only` names.
+    let only: BTreeSet<usize> = args.only.iter().copied().collect();
+    let bar = ProgressBar::new(if only.is_empty() {
+        args.trips
+    } else {
+        only.len()
+    } as u64);
     bar.set_style(
         ProgressStyle::with_template(
             "{spinner} drive     [{bar:40}] {pos}/{len} trips ({elapsed}, eta {eta})",
@@ -171,9 +189,12 @@ pub fn run(args: &DriveArgs) -> Result<()> {
             _ => goals[rng.random_range(0..goals.len())],
         };
         shared_goal.get_or_insert(goal);
-        trips.push(drive(
-            &terrain, known, graph, &settings, start, goal, &driving,
-        ));
+        if !only.is_empty() && !only.contains(&k) {
+            continue;
+        }
+        let mut trip = drive(&terrain, known, graph, &settings, start, goal, &driving);
+        trip.number = k;
+        trips.push(trip);
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -208,7 +229,11 @@ pub fn run(args: &DriveArgs) -> Result<()> {
         },
         format!(
             "Closed loop through rendered panoramas: {} trips to landmark {}",
-            trips.len().min(3),
+            trips
+                .iter()
+                .filter(|t| t.goal == trips[0].goal)
+                .take(3)
+                .count(),
             trips[0].goal
         ),
     );
@@ -330,13 +355,14 @@ fn trips_csv(trips: &[Trip]) -> String {
     let mut csv = String::from(
         "trip,start_x,start_y,goal,outcome,in_goal_cell,steps,replans,collisions,avoided,length_m,straight_m,reference_m,navigator_median_s,navigator_max_s\n",
     );
-    for (k, t) in trips.iter().enumerate() {
+    for t in trips {
         let mut seconds = t.navigator_seconds.clone();
         seconds.sort_by(f64::total_cmp);
         let outcome = serde_json::to_value(t.outcome).expect("outcome serialises");
         let _ = writeln!(
             csv,
-            "{k},{:.3},{:.3},{},{},{},{},{},{},{},{:.3},{:.3},{},{:.4},{:.4}",
+            "{},{:.3},{:.3},{},{},{},{},{},{},{},{:.3},{:.3},{},{:.4},{:.4}",
+            t.number,
             t.start[0],
             t.start[1],
             t.goal,
@@ -434,7 +460,7 @@ pub(super) struct Grid {
 
 /// 000 Fig. 6 over the rendered world: the map's landmarks at their rocks' positions, the RNG
 /// estimate, Voronoi borders, the navigator's decisions over a grid, and the first three trips
-/// (one shared goal).
+/// to `goal`.
 pub(super) fn figure(
     world: &World,
     landmark_rocks: &BTreeMap<LandmarkId, u32>,
@@ -449,7 +475,7 @@ pub(super) fn figure(
         .values()
         .map(|&r| world.rocks[r as usize].position)
         .collect();
-    let shown: Vec<&Trip> = trips.iter().take(3).collect();
+    let shown: Vec<&Trip> = trips.iter().filter(|t| t.goal == goal).take(3).collect();
     let (low, high) = bounds(
         raw.iter()
             .copied()

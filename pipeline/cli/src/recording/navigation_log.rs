@@ -34,8 +34,7 @@ pub fn write_drive_log(path: &Path, trips: &[Trip]) -> Result<(), Problem> {
     let channel = writer.add_channel(schema, TOPIC, "json", &BTreeMap::new())?;
     let steps = trips
         .iter()
-        .enumerate()
-        .flat_map(|(k, t)| t.steps.iter().map(move |s| (k, t.goal, s)));
+        .flat_map(|t| t.steps.iter().map(move |s| (t.number, t.goal, s)));
     for (sequence, (trip, goal, step)) in steps.enumerate() {
         let data = serde_json::to_vec(&StepMessage { trip, goal, step })?;
         let nanoseconds = sequence as u64 * 1_000_000_000;

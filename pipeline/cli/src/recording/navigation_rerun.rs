@@ -47,7 +47,7 @@ pub fn write_drive_rrd(path: &Path, scene: &DriveScene, trips: &[Trip]) -> Resul
         )
         .map_err(rerun)?;
     let mut sequence = 0i64;
-    for (k, trip) in trips.iter().enumerate() {
+    for trip in trips {
         let mut path: Vec<[f32; 2]> = Vec::new();
         for step in &trip.steps {
             stream.set_time_sequence(TIMELINE, sequence);
@@ -58,7 +58,7 @@ pub fn write_drive_rrd(path: &Path, scene: &DriveScene, trips: &[Trip]) -> Resul
                 .log(
                     "rover/position",
                     &rerun::Points2D::new([at])
-                        .with_labels([format!("trip {k} → L{}", trip.goal)])
+                        .with_labels([format!("trip {} → L{}", trip.number, trip.goal)])
                         .with_radii([0.25]),
                 )
                 .map_err(rerun)?;

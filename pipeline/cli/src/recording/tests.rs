@@ -351,6 +351,7 @@ fn trip(goal: u32, steps: usize) -> qrm_synth::closed_loop::Trip {
     use qrm_synth::closed_loop::{Outcome, StepLog, Trip};
     let commands = ["toward", "closing_in", "arrived", "lost"];
     Trip {
+        number: 0,
         start: [1.0, -2.0],
         goal,
         outcome: Outcome::Arrived,
