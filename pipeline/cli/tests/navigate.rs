@@ -385,6 +385,43 @@ fn drives_through_the_rendered_world_without_seeing_it() {
     };
     let honest = drive("a");
     assert_eq!(honest.len(), 2);
+    // `--only` drives one trip of the seeded sequence again, exactly as the whole drive did.
+    let only = |k: &str, out: &str| {
+        pipeline(&[
+            "navigate",
+            "drive",
+            "--images",
+            DEMO,
+            "--run",
+            run.to_str().unwrap(),
+            "--trips",
+            "2",
+            "--only",
+            k,
+            "--max-steps",
+            "12",
+            "--out",
+            dir.join(out).to_str().unwrap(),
+        ])
+    };
+    let o = only("1", "only");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let again: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("only").join("trips.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(again.as_array().unwrap().len(), 1);
+    assert_eq!(again[0]["number"], 1);
+    assert_eq!(again[0]["path"], honest[1].0);
+    let csv = std::fs::read_to_string(dir.join("only").join("trips.csv")).unwrap();
+    assert!(csv.lines().nth(1).unwrap().starts_with("1,"), "{csv}");
+    let o = only("2", "beyond");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--only 2: the drive has trips 0 to 1"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let eval_path = run.join("eval.json");
     let mut eval: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&eval_path).unwrap()).unwrap();
