@@ -310,9 +310,9 @@ fn drives_through_the_rendered_world_without_seeing_it() {
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path();
     let run = demo_run(dir);
-    let drive = |out: &str| {
-        let out = dir.join(out);
-        let o = pipeline(&[
+    // Two trips of at most 12 steps each, and `extra` arguments.
+    let two_trips = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
             "navigate",
             "drive",
             "--images",
@@ -325,7 +325,13 @@ fn drives_through_the_rendered_world_without_seeing_it() {
             "12",
             "--out",
             out.to_str().unwrap(),
-        ]);
+        ];
+        args.extend_from_slice(extra);
+        pipeline(&args)
+    };
+    let drive = |out: &str| {
+        let out = dir.join(out);
+        let o = two_trips(&out, &[]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         for file in [
             "trips.json",
@@ -386,24 +392,7 @@ fn drives_through_the_rendered_world_without_seeing_it() {
     let honest = drive("a");
     assert_eq!(honest.len(), 2);
     // `--only` drives one trip of the seeded sequence again, exactly as the whole drive did.
-    let only = |k: &str, out: &str| {
-        pipeline(&[
-            "navigate",
-            "drive",
-            "--images",
-            DEMO,
-            "--run",
-            run.to_str().unwrap(),
-            "--trips",
-            "2",
-            "--only",
-            k,
-            "--max-steps",
-            "12",
-            "--out",
-            dir.join(out).to_str().unwrap(),
-        ])
-    };
+    let only = |k: &str, out: &str| two_trips(&dir.join(out), &["--only", k]);
     let o = only("1", "only");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let again: serde_json::Value = serde_json::from_str(
