@@ -346,12 +346,13 @@ fn mcap_has_every_channel_once_per_station_matching_its_schema() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A trip of `steps` logged steps toward `goal`, every optional field set on odd steps only.
-fn trip(goal: u32, steps: usize) -> qrm_synth::closed_loop::Trip {
+/// Trip `number` of `steps` logged steps toward `goal`, every optional field set on odd steps
+/// only.
+fn trip(number: usize, goal: u32, steps: usize) -> qrm_synth::closed_loop::Trip {
     use qrm_synth::closed_loop::{Outcome, StepLog, Trip};
     let commands = ["toward", "closing_in", "arrived", "lost"];
     Trip {
-        number: 0,
+        number,
         start: [1.0, -2.0],
         goal,
         outcome: Outcome::Arrived,
@@ -391,7 +392,7 @@ fn trip(goal: u32, steps: usize) -> qrm_synth::closed_loop::Trip {
 fn drive_log_has_one_message_per_step_matching_its_schema() {
     let dir = scratch("drive");
     let path = dir.path().join("drive.mcap");
-    let trips = [trip(7, 5), trip(9, 3)];
+    let trips = [trip(0, 7, 5), trip(1, 9, 3)];
     navigation_log::write_drive_log(&path, &trips).unwrap();
     let bytes = std::fs::read(&path).unwrap();
     let mut seen = Vec::new();
