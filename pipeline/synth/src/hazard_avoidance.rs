@@ -402,7 +402,7 @@ mod tests {
     #[test]
     fn a_turn_never_takes_the_rover_back_where_its_last_step_began() {
         // How near the rover came to the goal rock's footprint, metres: a little over the
-        // clearance once it is round the neighbour; over two metres stepping back and forth.
+        // clearance once it is round the neighbour; 1.8 m stepping back and forth.
         let without = trip_to_the_densest_cluster(false);
         assert!(without > 1.0, "the old oscillation: {without}");
         let with = trip_to_the_densest_cluster(true);
