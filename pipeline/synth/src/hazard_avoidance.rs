@@ -13,6 +13,10 @@
 //!    [`LOOKAHEAD_M`] ahead on the bearing, or, when that point cannot be reached, toward
 //!    the reachable point nearest to it. The step cuts straight to the farthest point of the
 //!    path in clear sight, then follows the path; the rest of the path is the detour.
+//! 5. when the rover is in a pocket (step 4 finds nowhere nearer to go, and a place where one
+//!    of its last [`TRAIL_STEPS`] steps began lies outside the free space it can reach now):
+//!    back the way it came, step by step, to the latest such place, and on along step 4's
+//!    path from there; all of it is the detour.
 //!
 //! With none, the rover stays put for that step.
 //!
@@ -25,14 +29,21 @@
 //!   rover stepped 80° to one side, then 80° back to where it came from, until its step
 //!   budget ran out (marsyard seed 7, full resolution: 5 of the 10 failures of 100 trips).
 //!   Step 4 plans a way round instead.
+//! - Steps 2 and 3 test only where a step ends, so a step may cross the clearance between two
+//!   rocks into a pocket of free space one or two grid cells wide (marsyard seed 7: trips 70
+//!   and 90 of 100 stood still there to the end). Testing every step's whole segment would
+//!   avoid the pocket but change most paths through a cluster; backing out changes only the
+//!   trips that would stand still. The way back was driven before, and a rover hemmed in
+//!   from its start (nothing it drove lies outside its reach) still stays put.
 //! - Paths taken before turns steered the rover around the rocks it was driving to: the rock a
 //!   step runs into is often the landmark of the leg. The closed loop lost more trips.
 
-use crate::clearance_grid::{grown_footprints, Grid, RESOLUTION_M};
+use crate::clearance_grid::{grown_footprints, Cell, Grid, RESOLUTION_M};
 use crate::world::World;
 use pathfinding::directed::dijkstra::{build_path, dijkstra_all};
 use qrm_core::geometry::Point;
 use qrm_core::measurement::angular_distance;
+use std::collections::HashMap;
 
 /// How far ahead on the bearing a detour aims, metres.
 const LOOKAHEAD_M: f64 = 3.0;
@@ -48,6 +59,8 @@ const TURNS_DEG: [f64; 11] = [
 const DETOUR_TURN_DEG: f64 = 60.0;
 /// Spacing of the points at which a straight segment's clearance is tested, metres.
 const SAMPLE_M: f64 = 0.05;
+/// How many of its last steps the rover may back along out of a pocket (step 5).
+const TRAIL_STEPS: usize = 6;
 
 /// The hazard avoidance of one trip: the detour it is following, if any (step 4 of the
 /// module), kept while the commanded bearing stays within [`DETOUR_TURN_DEG`] of the one it
@@ -58,8 +71,8 @@ pub struct HazardAvoidance {
     detour: Vec<Point>,
     /// The bearing it was planned for (world frame, radians).
     azimuth: f64,
-    /// Where the last step started.
-    came_from: Option<Point>,
+    /// The last steps it drove (start, end), oldest first, at most [`TRAIL_STEPS`].
+    driven: Vec<(Point, Point)>,
 }
 
 impl HazardAvoidance {
@@ -74,15 +87,35 @@ impl HazardAvoidance {
         length: f64,
         clearance: f64,
     ) -> Option<Point> {
-        // The footprints that reach into sight, grown by the clearance.
+        // The footprints that reach into sight of anywhere on the trail, grown by the
+        // clearance.
+        let reach = SIGHT_M * std::f64::consts::SQRT_2 + TRAIL_STEPS as f64 * length;
         let near: Vec<(Point, f64)> = grown_footprints(world, clearance)
-            .filter(|&(p, grown)| p.distance(from) < SIGHT_M * std::f64::consts::SQRT_2 + grown)
+            .filter(|&(p, grown)| p.distance(from) < reach + grown)
             .collect();
         let next = self.next(&near, from, azimuth, length);
-        if next.is_some() {
-            self.came_from = Some(from);
+        if let Some(to) = next {
+            if self.driven.len() == TRAIL_STEPS {
+                self.driven.remove(0);
+            }
+            self.driven.push((from, to));
         }
         next
+    }
+
+    /// The way the rover came to `from`: the starts of the last steps it drove in a row up to
+    /// there, latest first.
+    fn trail(&self, from: Point) -> Vec<Point> {
+        let mut at = from;
+        let mut trail = Vec::new();
+        for &(start, end) in self.driven.iter().rev() {
+            if end != at {
+                break;
+            }
+            trail.push(start);
+            at = start;
+        }
+        trail
     }
 
     /// [`HazardAvoidance::drive`]'s step among the grown footprints `near`.
@@ -104,10 +137,8 @@ impl HazardAvoidance {
                 return Some(next);
             }
         }
-        let undoes = |p: Point| {
-            self.came_from
-                .is_some_and(|back| back.distance(p) < 0.5 * length)
-        };
+        let came_from = self.driven.last().map(|&(start, _)| start);
+        let undoes = |p: Point| came_from.is_some_and(|back| back.distance(p) < 0.5 * length);
         if let Some(next) = TURNS_DEG
             .iter()
             .map(|&t| (t, toward(from, azimuth + t.to_radians(), length)))
@@ -116,7 +147,9 @@ impl HazardAvoidance {
         {
             return Some(next);
         }
-        let way = around(near, from, toward(from, azimuth, LOOKAHEAD_M))?;
+        let subgoal = toward(from, azimuth, LOOKAHEAD_M);
+        let way = around(near, from, subgoal)
+            .or_else(|| out_of_pocket(near, from, &self.trail(from), subgoal))?;
         let (next, rest) = along(&way, length);
         self.detour = rest;
         self.azimuth = azimuth;
@@ -152,10 +185,11 @@ pub(crate) fn toward(from: Point, azimuth: f64, length: f64) -> Point {
 /// `from`; `near` are the grown footprints that reach into sight. `None` when the rover is as
 /// near to the subgoal as it can get.
 fn around(near: &[(Point, f64)], from: Point, subgoal: Point) -> Option<Vec<Point>> {
-    let sight = Point::new(SIGHT_M, SIGHT_M);
-    let grid = Grid::over(near, from - sight, from + sight);
-    let start = grid.cell(from);
-    let reached = dijkstra_all(&start, |&c| grid.free_neighbours(c));
+    let Reach {
+        grid,
+        start,
+        reached,
+    } = Reach::from(near, from);
     // The subgoal if the rover can get there, else as near to it as it can get; the shorter
     // way among equals.
     let (end, _) = reached
@@ -180,6 +214,50 @@ fn around(near: &[(Point, f64)], from: Point, subgoal: Point) -> Option<Vec<Poin
             .chain(path[cut..].iter().copied())
             .collect(),
     )
+}
+
+/// The way out of a pocket (the module's step 5): from `from` back along `trail` (where the
+/// last steps began, latest first) to the latest place outside the free space the rover can
+/// reach from `from`, then step 4's path from there toward `subgoal`. `None` when every place
+/// on the trail is within reach: the rover is hemmed in, not in a pocket.
+fn out_of_pocket(
+    near: &[(Point, f64)],
+    from: Point,
+    trail: &[Point],
+    subgoal: Point,
+) -> Option<Vec<Point>> {
+    let reach = Reach::from(near, from);
+    let exit = trail.iter().position(|&p| {
+        let cell = reach.grid.cell(p);
+        reach.grid.is_free(cell) && cell != reach.start && !reach.reached.contains_key(&cell)
+    })?;
+    let back = std::iter::once(from).chain(trail[..=exit].iter().copied());
+    let onward = around(near, trail[exit], subgoal).unwrap_or_default();
+    Some(back.chain(onward.into_iter().skip(1)).collect())
+}
+
+/// The clearance grid over the hazard cameras' sight around a rover, and the cells it can
+/// reach from the one it stands in.
+struct Reach {
+    grid: Grid,
+    start: Cell,
+    /// Each reachable cell's predecessor and cost from `start` (`dijkstra_all`).
+    reached: HashMap<Cell, (Cell, u64)>,
+}
+
+impl Reach {
+    /// The reach of a rover at `from` among the grown footprints `near`.
+    fn from(near: &[(Point, f64)], from: Point) -> Reach {
+        let sight = Point::new(SIGHT_M, SIGHT_M);
+        let grid = Grid::over(near, from - sight, from + sight);
+        let start = grid.cell(from);
+        let reached = dijkstra_all(&start, |&c| grid.free_neighbours(c));
+        Reach {
+            grid,
+            start,
+            reached,
+        }
+    }
 }
 
 /// The point `length` metres along the polyline `way` (or its end, if it is shorter), and the
@@ -368,11 +446,8 @@ mod tests {
         assert!(at.distance(centre) < 0.5, "{at:?}");
     }
 
-    /// Trip 7 of `navigate drive --trips 100 --seed 1` on marsyard seed 7 (full resolution),
-    /// from its 18th step on: the rover is sent at a small rock whose neighbours close both
-    /// ways to it. With turns alone it stepped 80° to one side and 80° back, to the end of
-    /// the trip.
-    fn trip_to_the_densest_cluster(remember: bool) -> f64 {
+    /// The world of `pipeline synth --preset marsyard --seed 7`.
+    fn marsyard_seed_7() -> World {
         let layout = Preset::Marsyard.layout(
             7,
             Counts {
@@ -380,14 +455,22 @@ mod tests {
                 stations: Some(50),
             },
         );
-        let world = World::generate(7, &layout.rocks);
+        World::generate(7, &layout.rocks)
+    }
+
+    /// Trip 7 of `navigate drive --trips 100 --seed 1` on marsyard seed 7 (full resolution),
+    /// from its 18th step on: the rover is sent at a small rock whose neighbours close both
+    /// ways to it. With turns alone it stepped 80° to one side and 80° back, to the end of
+    /// the trip.
+    fn trip_to_the_densest_cluster(remember: bool) -> f64 {
+        let world = marsyard_seed_7();
         let goal = world.rocks[22].position;
         let mut avoidance = HazardAvoidance::default();
         let mut at = Point::new(15.70, 9.57);
         let mut nearest = f64::INFINITY;
         for _ in 0..10 {
             if !remember {
-                avoidance.came_from = None;
+                avoidance.driven.clear();
             }
             let azimuth = (goal.y - at.y).atan2(goal.x - at.x);
             if let Some(next) = avoidance.drive(&world, at, azimuth, 0.5, CLEARANCE) {
@@ -407,5 +490,34 @@ mod tests {
         assert!(without > 1.0, "the old oscillation: {without}");
         let with = trip_to_the_densest_cluster(true);
         assert!(with < CLEARANCE + 0.2, "{with}");
+    }
+
+    /// Trip 70 of `navigate drive --trips 100 --seed 1` on marsyard seed 7 (full resolution),
+    /// from its 16th step on: sent west past rock 20 toward rock 4, the rover stepped across
+    /// the clearance between rocks 20 and 22 into a pocket, and stood there to the end.
+    #[test]
+    fn a_rover_that_stepped_into_a_pocket_backs_out_the_way_it_came() {
+        let world = marsyard_seed_7();
+        let goal = world.rocks[4].position;
+        let to_goal = |at: Point| (goal.y - at.y).atan2(goal.x - at.x);
+        let mut avoidance = HazardAvoidance::default();
+        let mut at = Point::new(15.388901413668565, 7.478448110565559);
+        let mut nearest = f64::INFINITY;
+        for step in 0..30 {
+            if step == 2 {
+                // In the pocket: a rover that came from nowhere stays put here.
+                let fresh =
+                    HazardAvoidance::default().drive(&world, at, to_goal(at), 0.5, CLEARANCE);
+                assert_eq!(fresh, None, "not a pocket at {at:?}");
+            }
+            let next = avoidance
+                .drive(&world, at, to_goal(at), 0.5, CLEARANCE)
+                .unwrap_or_else(|| panic!("stuck at {at:?} after {step} steps"));
+            assert!(clear_of(&world, next), "{next:?}");
+            at = next;
+            nearest = nearest.min(at.distance(goal) - world.contact_radius(4));
+        }
+        // Round rock 20 the other way, up to the clearance of the goal rock's footprint.
+        assert!(nearest < CLEARANCE + 0.1, "{nearest}");
     }
 }
