@@ -476,8 +476,8 @@ pub fn drive(
                             .filter_map(|(_, s)| s.way_from(odometry))
                             .collect();
                         let goal_way = seen.way_from(odometry)?;
-                        far_side(terrain, pose, goal_way, &others, driving.step_m)
-                            .map(|(bearing, run)| (bearing, Approach::Straight(run)))
+                        far_side(goal_way, &others, driving.step_m)
+                            .map(|(bearing, length)| (bearing, Approach::Around(length)))
                     })
                 }),
             _ => None,
@@ -509,7 +509,10 @@ pub fn drive(
             Some((_, Approach::Straight(run))) => {
                 toward(pose.position, pose.heading + bearing, run)
             }
-            Some((_, Approach::Around)) | None => step(
+            Some((_, Approach::Around(length))) => {
+                step(terrain, &mut avoidance, pose, bearing, length, &mut trip)
+            }
+            None => step(
                 terrain,
                 &mut avoidance,
                 pose,
@@ -596,9 +599,10 @@ impl Sighted {
 enum Approach {
     /// Straight on the bearing, this many metres.
     Straight(f64),
-    /// Around a rock in the way that is not the goal's (farther from its place than the
-    /// hazard cameras' stop), as the hazard avoidance drives a step.
-    Around,
+    /// This many metres on the bearing, as the hazard avoidance drives a step: around a rock
+    /// in the way that is not the goal's (farther from its place than the hazard cameras'
+    /// stop), or round the goal to its far side ([`far_side`]).
+    Around(f64),
 }
 
 /// The final approach's next step once the follower has arrived, from dead reckoning
@@ -637,27 +641,25 @@ fn final_approach(
     }
     // Stopped: by the goal's rock, or by another one in front of it.
     let near_side = left - 0.5 * (range.high - range.low);
-    (near_side > 2.0 * CLEARANCE_M).then_some((bearing, Approach::Around))
+    (near_side > 2.0 * CLEARANCE_M).then_some((bearing, Approach::Around(step_m)))
 }
 
 /// The next step round the goal once the rover can drive no nearer to it, if another landmark
 /// it remembers (`others`, the ways to their estimated places by dead reckoning, as `goal`'s)
 /// is less than [`FAR_SIDE_MARGIN_M`] farther from the rover than the goal: along the circle
 /// about the goal's place through the rover, the shorter way round toward the point of that
-/// circle farthest into the goal's cell, at most a step, up to where the hazard cameras stop
-/// the rover. `(bearing, run)`; `None` when no point of the circle is better.
+/// circle farthest into the goal's cell, at most a step. `(bearing, length)` of the chord to
+/// drive, as the hazard avoidance drives a step; `None` when no point of the circle is better.
 ///
 /// Why: closing in ends at the first rock's clearance on the way to the goal. Between two rocks
 /// standing close together, that is where their cells meet (marsyard seed 11, half resolution:
 /// three of 40 trips ended 0.5–0.8 m from both the goal and a neighbour, within 0.06 m of the
-/// border, on the neighbour's side).
-fn far_side(
-    terrain: &Terrain,
-    pose: Pose,
-    goal: Point,
-    others: &[Point],
-    step_m: f64,
-) -> Option<(f64, f64)> {
+/// border, on the neighbour's side). The chord is driven by the hazard avoidance, which tests
+/// where a step ends: held to the straight run the hazard cameras allow, a rover stopped at
+/// the goal's clearance could not start round it, as every chord of the circle dips into it
+/// (marsyard seed 7, full resolution: trips 33 and 94 of 100 stopped there 0.1–0.2 m from the
+/// goal's cell).
+fn far_side(goal: Point, others: &[Point], step_m: f64) -> Option<(f64, f64)> {
     let here = Point::new(0.0, 0.0);
     // How much nearer the goal's place is than every other landmark's.
     let margin = |x: Point| {
@@ -682,15 +684,8 @@ fn far_side(
     }
     let turn = (best - start).sin().atan2((best - start).cos());
     let next = on_circle(start + turn.signum() * (step_m / radius).min(turn.abs()));
-    let bearing = next.y.atan2(next.x);
-    let run = clear_run(
-        terrain.world,
-        pose.position,
-        pose.heading + bearing,
-        next.distance(here),
-        CLEARANCE_M,
-    );
-    (run >= MIN_APPROACH_M).then_some((bearing, run))
+    let length = next.distance(here);
+    (length >= MIN_APPROACH_M).then_some((next.y.atan2(next.x), length))
 }
 
 /// How much nearer than any other landmark the rover should be to the goal's estimated place
@@ -1007,7 +1002,7 @@ mod tests {
         let stopped = 2.0 - world.contact_radius(1) - CLEARANCE_M;
         let (bearing, how) =
             final_approach(&terrain, at(stopped), &seen, Point::new(stopped, 0.0), 0.5).unwrap();
-        assert_eq!((bearing, how), (0.0, Approach::Around));
+        assert_eq!((bearing, how), (0.0, Approach::Around(0.5)));
         // Stopped by the goal itself: done.
         let at_goal = near_side - CLEARANCE_M;
         let done = final_approach(&terrain, at(at_goal), &seen, Point::new(at_goal, 0.0), 0.5);
@@ -1016,59 +1011,55 @@ mod tests {
 
     #[test]
     fn the_rover_rounds_the_goal_away_from_a_neighbour_as_near_as_the_goal() {
-        let calib = default_calibration();
         let (goal, neighbour) = (Point::new(2.0, 0.0), Point::new(2.0, 1.2));
-        let world = World::generate(6, &[(goal, 0.2), (neighbour, 0.2)]);
-        let rocks = BTreeMap::from([(0, 0), (1, 1)]);
-        let terrain = Terrain {
-            world: &world,
-            calib: &calib,
-            landmark_rocks: &rocks,
-        };
-        // Heading 0: the panorama's frame is the world's, less the rover's position.
-        let at = |x: f64, y: f64| Pose {
-            position: Point::new(x, y),
-            heading: 0.0,
-        };
-        let way = |from: Pose, to: Point| to - from.position;
-        // On the border of the two cells: a step round the goal, clear of both rocks, into
-        // the goal's cell, as far from the goal's centre as before.
-        let border = at(1.4, 0.6);
-        let (bearing, run) = far_side(
-            &terrain,
-            border,
-            way(border, goal),
-            &[way(border, neighbour)],
-            0.5,
-        )
-        .expect("a step round the goal");
-        let next = toward(border.position, bearing, run);
-        assert!(run > 0.3, "{run}");
+        let way = |from: Point, to: Point| to - from;
+        // On the border of the two cells: a step round the goal into the goal's cell, as far
+        // from the goal's centre as before (heading 0: the panorama's frame is the world's,
+        // less the rover's position).
+        let border = Point::new(1.4, 0.6);
+        let (bearing, length) = far_side(way(border, goal), &[way(border, neighbour)], 0.5)
+            .expect("a step round the goal");
+        let next = toward(border, bearing, length);
+        assert!(length > 0.3, "{length}");
         let margin = |p: Point| p.distance(neighbour) - p.distance(goal);
-        assert!(margin(next) > margin(border.position) + 0.2, "{next:?}");
-        assert!((next.distance(goal) - border.position.distance(goal)).abs() < 0.1);
+        assert!(margin(next) > margin(border) + 0.2, "{next:?}");
+        assert!((next.distance(goal) - border.distance(goal)).abs() < 1e-9);
         // Its first step takes the shorter way round: west of the goal, away from the
         // neighbour.
-        assert!(
-            next.x < border.position.x && next.y < border.position.y,
-            "{next:?}"
-        );
+        assert!(next.x < border.x && next.y < border.y, "{next:?}");
         // Clearly in the goal's cell, or with no other landmark remembered: no step.
-        let inside = at(1.3, -0.2);
+        let inside = Point::new(1.3, -0.2);
         assert_eq!(
-            far_side(
-                &terrain,
-                inside,
-                way(inside, goal),
-                &[way(inside, neighbour)],
-                0.5
-            ),
+            far_side(way(inside, goal), &[way(inside, neighbour)], 0.5),
             None
         );
-        assert_eq!(
-            far_side(&terrain, border, way(border, goal), &[], 0.5),
-            None
-        );
+        assert_eq!(far_side(way(border, goal), &[], 0.5), None);
+    }
+
+    #[test]
+    fn a_rover_stopped_at_the_goals_clearance_still_rounds_it() {
+        // Closing in ends where the hazard cameras stop the rover: at the clearance of the
+        // goal's footprint, here nearly on the border with a neighbour's cell.
+        let (goal, neighbour) = (Point::new(2.0, 0.0), Point::new(2.0, 1.0));
+        let world = World::generate(6, &[(goal, 0.2), (neighbour, 0.2)]);
+        let stop_radius = world.contact_radius(0) + CLEARANCE_M + 1e-3;
+        let angle = 120f64.to_radians();
+        let stopped = goal + Point::new(stop_radius * angle.cos(), stop_radius * angle.sin());
+        let margin = |p: Point| p.distance(neighbour) - p.distance(goal);
+        assert!(margin(stopped) < FAR_SIDE_MARGIN_M, "{}", margin(stopped));
+        let (bearing, length) =
+            far_side(goal - stopped, &[neighbour - stopped], 0.5).expect("a step round the goal");
+        // Every chord of the circle dips into the goal's clearance: the hazard cameras allow
+        // no straight run along it, and a rover held to that run stood there.
+        assert!(clear_run(&world, stopped, bearing, length, CLEARANCE_M) < MIN_APPROACH_M);
+        // Driven as the hazard avoidance drives a step, it goes round, clear of both rocks.
+        let next = HazardAvoidance::default()
+            .drive(&world, stopped, bearing, length, CLEARANCE_M)
+            .expect("a clear step");
+        for (k, rock) in (0..).zip([goal, neighbour]) {
+            assert!(next.distance(rock) >= world.contact_radius(k) + CLEARANCE_M);
+        }
+        assert!(margin(next) > margin(stopped) + 0.3, "{next:?}");
     }
 
     #[test]
