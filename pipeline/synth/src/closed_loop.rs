@@ -12,8 +12,10 @@
 //! each step on the commanded bearing. A step that would end within [`CLEARANCE_M`] of a
 //! rock's footprint is turned by 20° at a time, alternately either way, up to 100°, never back
 //! to where the last step began; when every turn is blocked, the rover follows the shortest
-//! clear path around the rocks within a few metres, and keeps to it while the bearing holds.
-//! With no clear way the rover stays put for that step. A step that crosses a footprint anyway counts as a collision.
+//! clear path around the rocks within a few metres, and keeps to it while the bearing holds;
+//! when that path leads nowhere because a step slipped between rocks into a pocket, the rover
+//! backs out the way it came. With no clear way the rover stays put for that step. A step that
+//! crosses a footprint anyway counts as a collision.
 //!
 //! The follower's cell is that of the nearest *identified* landmark (`navigation::cell_of`
 //! over them; the first of the possible ones when the order cannot tell), as in the

@@ -148,8 +148,9 @@ impl HazardAvoidance {
             return Some(next);
         }
         let subgoal = toward(from, azimuth, LOOKAHEAD_M);
-        let way = around(near, from, subgoal)
-            .or_else(|| out_of_pocket(near, from, &self.trail(from), subgoal))?;
+        let reach = Reach::from(near, from);
+        let way = around(near, &reach, from, subgoal)
+            .or_else(|| out_of_pocket(near, &reach, from, &self.trail(from), subgoal))?;
         let (next, rest) = along(&way, length);
         self.detour = rest;
         self.azimuth = azimuth;
@@ -182,14 +183,15 @@ pub(crate) fn toward(from: Point, azimuth: f64, length: f64) -> Point {
 }
 
 /// The shortest clear path from `from` toward `subgoal` (see the module's step 4), starting at
-/// `from`; `near` are the grown footprints that reach into sight. `None` when the rover is as
-/// near to the subgoal as it can get.
-fn around(near: &[(Point, f64)], from: Point, subgoal: Point) -> Option<Vec<Point>> {
+/// `from`; `near` are the grown footprints that reach into sight, `reach` the rover's reach
+/// among them from `from`. `None` when the rover is as near to the subgoal as it can get.
+fn around(near: &[(Point, f64)], reach: &Reach, from: Point, subgoal: Point) -> Option<Vec<Point>> {
     let Reach {
         grid,
         start,
         reached,
-    } = Reach::from(near, from);
+    } = reach;
+    let start = *start;
     // The subgoal if the rover can get there, else as near to it as it can get; the shorter
     // way among equals.
     let (end, _) = reached
@@ -200,7 +202,7 @@ fn around(near: &[(Point, f64)], from: Point, subgoal: Point) -> Option<Vec<Poin
     if end == start {
         return None;
     }
-    let path: Vec<Point> = build_path(&end, &reached)
+    let path: Vec<Point> = build_path(&end, reached)
         .into_iter()
         .map(|c| grid.point(c))
         .collect();
@@ -218,21 +220,22 @@ fn around(near: &[(Point, f64)], from: Point, subgoal: Point) -> Option<Vec<Poin
 
 /// The way out of a pocket (the module's step 5): from `from` back along `trail` (where the
 /// last steps began, latest first) to the latest place outside the free space the rover can
-/// reach from `from`, then step 4's path from there toward `subgoal`. `None` when every place
-/// on the trail is within reach: the rover is hemmed in, not in a pocket.
+/// reach from `from` (`reach`), then step 4's path from there toward `subgoal`. `None` when
+/// every place on the trail is within reach: the rover is hemmed in, not in a pocket.
 fn out_of_pocket(
     near: &[(Point, f64)],
+    reach: &Reach,
     from: Point,
     trail: &[Point],
     subgoal: Point,
 ) -> Option<Vec<Point>> {
-    let reach = Reach::from(near, from);
     let exit = trail.iter().position(|&p| {
         let cell = reach.grid.cell(p);
         reach.grid.is_free(cell) && cell != reach.start && !reach.reached.contains_key(&cell)
     })?;
     let back = std::iter::once(from).chain(trail[..=exit].iter().copied());
-    let onward = around(near, trail[exit], subgoal).unwrap_or_default();
+    let onward =
+        around(near, &Reach::from(near, trail[exit]), trail[exit], subgoal).unwrap_or_default();
     Some(back.chain(onward.into_iter().skip(1)).collect())
 }
 
