@@ -24,7 +24,7 @@ fn end_quietly_on_broken_pipe() {}
 /// Keeps freed full-frame buffers in the heap for the next panorama. Detection allocates a
 /// few buffers of megabytes per panorama; glibc serves blocks that large by `mmap` and unmaps
 /// them on free, so every panorama faulted its pages in afresh, a tenth of detection's time
-/// (docs/BENCHMARKS.md, the navigator's time per step).
+/// (docs/BENCHMARKS.md, "Freed buffers kept in the heap"). A setting refused only costs speed.
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 fn keep_freed_buffers() {
     /// glibc's largest mmap threshold on 64-bit systems (`mallopt(3)`): larger than a
