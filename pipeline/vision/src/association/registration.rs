@@ -122,15 +122,11 @@ pub fn register(
         .copied()
         .filter(|&(i, j)| seed(i, frame.landmarks[j].0))
         .collect();
-    let hypotheses = hypotheses(
-        current,
-        frame,
-        &seeds,
-        &Candidates::new(current, frame, &correspondences),
-    );
+    let candidates = Candidates::new(current, frame, &correspondences);
+    let mut hypotheses = hypotheses(current, frame, &seeds, &candidates);
     let chance = chance(frame, &seeds, &correspondences);
-    let inliers =
-        decisive(&hypotheses).or_else(|| significant(current, frame, &hypotheses, &chance))?;
+    let inliers = decisive(&mut hypotheses, &candidates)
+        .or_else(|| significant(current, frame, &mut hypotheses, &candidates, &chance))?;
     let nfa = core(current, frame, &inliers, &chance).0;
     let (motion, pairs) = unambiguous(current, frame, &inliers);
     (pairs.len() >= MIN_INLIERS).then(|| Registration {
@@ -140,60 +136,147 @@ pub fn register(
     })
 }
 
-/// One motion hypothesis: its correspondences within tolerance, `(detection, index into the
-/// frame's landmarks)`, and how tightly they fit.
+/// One motion hypothesis, scored only when its score can matter: most hypotheses cannot come
+/// near the best one's, and scoring (the placements' ellipse tests) took most of a
+/// registration's time.
 struct Hypothesis {
+    motion: Motion,
+    /// How many detections the motion brings within reach of a look-alike ([`within_reach`]):
+    /// no more can be its inliers, so its score is no higher.
+    most: usize,
+    fit: Option<Fit>,
+}
+
+/// A scored hypothesis: its correspondences within tolerance, `(detection, index into the
+/// frame's landmarks)`, and how tightly they fit (Σ (1 − (d / tolerance)²) over them, so that
+/// a loose fit of many does not beat a tight fit of nearly as many).
+struct Fit {
     inliers: Vec<(usize, usize)>,
     score: f64,
 }
 
-/// Every motion hypothesised from two seed correspondences whose distances agree, with the
-/// correspondences it fits. Hypotheses are scored by how tightly they fit: Σ (1 − (d /
-/// tolerance)²) over their correspondences, so that a loose fit of many does not beat a tight
-/// fit of nearly as many.
+impl Hypothesis {
+    /// Its fit, scored now if it was not yet.
+    fn scored(&mut self, candidates: &Candidates) -> &Fit {
+        self.fit.get_or_insert_with(|| {
+            let (inliers, score) = matches(candidates, &self.motion);
+            Fit { inliers, score }
+        })
+    }
+}
+
+/// Every motion hypothesised from two seed correspondences whose distances agree, with how
+/// many correspondences it may fit at most; none is scored yet.
 fn hypotheses(
     current: &[Option<Placed>],
     frame: &Frame,
     seeds: &[(usize, usize)],
     candidates: &Candidates,
 ) -> Vec<Hypothesis> {
+    let detection = |i: usize| current[i].expect("seeds are placed");
+    let landmark = |j: usize| frame.landmarks[j].1;
+    let between_detections = Baselines::new(seeds.iter().map(|s| s.0), current.len(), detection);
+    let between_landmarks =
+        Baselines::new(seeds.iter().map(|s| s.1), frame.landmarks.len(), landmark);
     let mut out = Vec::new();
     for (x, &(i1, j1)) in seeds.iter().enumerate() {
         for &(i2, j2) in &seeds[x + 1..] {
             if i1 == i2 || j1 == j2 {
                 continue;
             }
-            let (p1, p2) = (
-                current[i1].expect("filtered"),
-                current[i2].expect("filtered"),
-            );
-            let (q1, q2) = (frame.landmarks[j1].1, frame.landmarks[j2].1);
-            let (dp, dq) = (distance(p1.point, p2.point), distance(q1.point, q2.point));
-            // How much each placement lets the distance between two of them vary: its reach
-            // along the line joining them.
-            let (up, uq) = (unit(p1.point, p2.point), unit(q1.point, q2.point));
-            let tolerance =
-                p1.extent(up) + p2.extent(up) + q1.extent(uq) + q2.extent(uq) + 2.0 * SLACK_M;
+            let (dp, p1_extent, p2_extent) = between_detections.between(i1, i2);
+            let (dq, q1_extent, q2_extent) = between_landmarks.between(j1, j2);
+            let tolerance = p1_extent + p2_extent + q1_extent + q2_extent + 2.0 * SLACK_M;
             // Short baselines give a poorly determined rotation.
             if (dp - dq).abs() > tolerance || dp < tolerance {
                 continue;
             }
-            let motion = Motion::from_pairs([p1.point, p2.point], [q1.point, q2.point]);
-            let (inliers, score) = matches(candidates, &motion);
-            out.push(Hypothesis { inliers, score });
+            let motion = Motion::from_pairs(
+                [detection(i1).point, detection(i2).point],
+                [landmark(j1).point, landmark(j2).point],
+            );
+            let most = within_reach(candidates, &motion);
+            out.push(Hypothesis {
+                motion,
+                most,
+                fit: None,
+            });
         }
     }
     out
 }
 
+/// The distance between every two of some placements, and how far each reaches along the line
+/// joining them (how much it lets that distance vary): computed once for each two placements
+/// rather than for each two seed pairs that hold them (a registration tries hundreds of seed
+/// pairs over a few dozen placements).
+struct Baselines {
+    /// Each placement's row in the table, by its index (none for those not used).
+    row: Vec<Option<usize>>,
+    used: usize,
+    /// For rows `a`, `b`: the distance from `a` to `b`, and `a`'s and `b`'s extent along it.
+    table: Vec<(f64, f64, f64)>,
+}
+
+impl Baselines {
+    /// The table over the placements `used` (indices below `len`, repeats allowed), each
+    /// given by `placed`.
+    fn new(
+        used: impl Iterator<Item = usize>,
+        len: usize,
+        placed: impl Fn(usize) -> Placed,
+    ) -> Baselines {
+        let mut row = vec![None; len];
+        let mut indices = Vec::new();
+        for index in used {
+            if row[index].is_none() {
+                row[index] = Some(indices.len());
+                indices.push(index);
+            }
+        }
+        let placed = &placed;
+        let table = indices
+            .iter()
+            .flat_map(|&a| indices.iter().map(move |&b| (placed(a), placed(b))))
+            .map(|(a, b)| {
+                let along = unit(a.point, b.point);
+                (distance(a.point, b.point), a.extent(along), b.extent(along))
+            })
+            .collect();
+        Baselines {
+            row,
+            used: indices.len(),
+            table,
+        }
+    }
+
+    /// The distance from placement `a` to placement `b`, and their extents along it.
+    fn between(&self, a: usize, b: usize) -> (f64, f64, f64) {
+        let row = |index: usize| self.row[index].expect("a placement of the table");
+        self.table[row(a) * self.used + row(b)]
+    }
+}
+
 /// The inliers of the best-scoring hypothesis, if it explains at least [`MIN_INLIERS`] and
 /// scores [`MARGIN`] more than any hypothesis with a different assignment.
-fn decisive(hypotheses: &[Hypothesis]) -> Option<Vec<(usize, usize)>> {
-    let best = hypotheses
-        .iter()
-        .max_by(|a, b| a.score.total_cmp(&b.score))?;
-    let runner_up = hypotheses
-        .iter()
+///
+/// Hypotheses are scored from the highest bound down ([`Hypothesis::most`]), and no further
+/// once no bound left comes within the margin of the best score so far: such a hypothesis can
+/// neither be the best nor stop it winning, whatever its assignment, so the answer is the one
+/// scoring every hypothesis gives (marsyard seed 7: about a fifth of them are scored).
+fn decisive(hypotheses: &mut [Hypothesis], candidates: &Candidates) -> Option<Vec<(usize, usize)>> {
+    let mut order: Vec<usize> = (0..hypotheses.len()).collect();
+    order.sort_by_key(|&k| std::cmp::Reverse(hypotheses[k].most));
+    let mut top = f64::NEG_INFINITY;
+    for k in order {
+        if hypotheses[k].most as f64 + MARGIN <= top {
+            break;
+        }
+        top = top.max(hypotheses[k].scored(candidates).score);
+    }
+    let scored = || hypotheses.iter().filter_map(|h| h.fit.as_ref());
+    let best = scored().max_by(|a, b| a.score.total_cmp(&b.score))?;
+    let runner_up = scored()
         .filter(|h| !same_assignment(&h.inliers, &best.inliers))
         .map(|h| h.score)
         .fold(0.0, f64::max);
@@ -248,11 +331,15 @@ fn chance(frame: &Frame, seeds: &[(usize, usize)], correspondences: &[(usize, us
 fn significant(
     current: &[Option<Placed>],
     frame: &Frame,
-    hypotheses: &[Hypothesis],
+    hypotheses: &mut [Hypothesis],
+    candidates: &Candidates,
     chance: &Chance,
 ) -> Option<Vec<(usize, usize)>> {
+    // A hypothesis bounded below the fewest inliers cannot have them: it is left unscored.
     let judged: Vec<(f64, Vec<(usize, usize)>)> = hypotheses
-        .iter()
+        .iter_mut()
+        .filter(|h| h.most >= MIN_INLIERS)
+        .map(|h| h.scored(candidates))
         .filter(|h| h.inliers.len() >= MIN_INLIERS)
         .map(|h| core(current, frame, &h.inliers, chance))
         .collect();
@@ -740,9 +827,9 @@ impl Motion {
 struct Candidates {
     /// Detections with a placement and a look-alike in the frame.
     detections: Vec<Candidate>,
-    /// Each detection's look-alike landmarks in turn: the landmark's index into the frame's
-    /// landmarks, its coordinates and its grown placement's reach, side by side so that the
-    /// distance test runs over them without looking up the others.
+    /// Each detection's look-alike landmarks in turn, sorted by x: the landmark's index into
+    /// the frame's landmarks, its coordinates and its grown placement's reach, side by side so
+    /// that the distance test runs over them without looking up the others.
     alike: Vec<(usize, [f64; 2], f64)>,
     /// The frame's landmarks' placements grown by half the slack.
     grown: Vec<Matrix2<f64>>,
@@ -758,6 +845,19 @@ struct Candidate {
     reach: f64,
     /// Where its look-alikes lie in [`Candidates::alike`].
     alike: std::ops::Range<usize>,
+    /// Its widest reach to one of them (both grown placements' reach), a little wide.
+    widest: f64,
+    /// Its look-alikes in buckets by x ([`Candidate::bucket`]): `starts[k]` is where bucket
+    /// `k` begins among them, and the last is their count.
+    starts: Vec<usize>,
+}
+
+impl Candidate {
+    /// The bucket of `x`, in steps of `widest` from bucket 1 at the first look-alike's x
+    /// (`first`), as a number: below 0 left of bucket 0, NaN for a NaN `x`.
+    fn bucket(&self, first: f64, x: f64) -> f64 {
+        (x - first) / self.widest + 1.0
+    }
 }
 
 impl Candidates {
@@ -780,11 +880,30 @@ impl Candidates {
                     grown: p.grown(half),
                     reach: p.reach() + half,
                     alike: alike.len()..alike.len(),
+                    widest: 0.0,
+                    starts: Vec::new(),
                 });
             }
             let q = frame.landmarks[j].1;
-            alike.push((j, q.point, q.reach() + half));
-            detections.last_mut().expect("pushed above").alike.end = alike.len();
+            let landmark_reach = q.reach() + half;
+            alike.push((j, q.point, landmark_reach));
+            let detection = detections.last_mut().expect("pushed above");
+            detection.alike.end = alike.len();
+            // Wider than the reach by far more than rounding, so that the buckets of
+            // [`Candidates::near`] never leave out a pair that [`in_reach`] takes.
+            detection.widest = detection
+                .widest
+                .max((detection.reach + landmark_reach) * (1.0 + 1e-6));
+        }
+        for detection in &mut detections {
+            let listed = &mut alike[detection.alike.clone()];
+            listed.sort_by(|a, b| a.1[0].total_cmp(&b.1[0]));
+            let first = listed[0].1[0];
+            let bucket = |a: &(usize, [f64; 2], f64)| detection.bucket(first, a.1[0]) as usize;
+            let last = bucket(&listed[listed.len() - 1]);
+            detection.starts = (0..=last + 1)
+                .map(|k| listed.partition_point(|a| bucket(a) < k))
+                .collect();
         }
         Candidates {
             detections,
@@ -792,6 +911,48 @@ impl Candidates {
             grown: frame.landmarks.iter().map(|(_, q)| q.grown(half)).collect(),
         }
     }
+
+    /// The look-alikes of `candidate` that it may reach from `moved`: those in the bucket of
+    /// `moved`'s x and the two beside it, which hold every look-alike within its widest reach
+    /// in x (under most motions a detection lands near few of its look-alikes, or none).
+    fn near(&self, candidate: &Candidate, moved: [f64; 2]) -> &[(usize, [f64; 2], f64)] {
+        let listed = &self.alike[candidate.alike.clone()];
+        let last = candidate.starts.len() - 2;
+        let k = candidate.bucket(listed[0].1[0], moved[0]);
+        // A degenerate motion (NaN) reaches nothing.
+        if k.is_nan() || k < 0.0 || k as usize > last + 1 {
+            return &[];
+        }
+        let k = k as usize;
+        &listed[candidate.starts[k.saturating_sub(1)]..candidate.starts[(k + 1).min(last) + 1]]
+    }
+}
+
+/// Whether a detection moved to `moved`, its grown placement reaching `reach`, lies within
+/// reach of a landmark at `point` reaching `landmark_reach`: beyond both placements' reach the
+/// pair is off whatever their shapes; most pairs are, and the test needs no ellipse.
+fn in_reach(moved: [f64; 2], reach: f64, point: [f64; 2], landmark_reach: f64) -> bool {
+    let (dx, dy) = (moved[0] - point[0], moved[1] - point[1]);
+    let bound = reach + landmark_reach;
+    dx * dx + dy * dy <= bound * bound * (1.0 + 1e-9)
+}
+
+/// How many detections `motion` brings within reach of one of their look-alikes: a bound on
+/// how many it can pair one to one ([`matches`] tests the same pairs), and so on its score.
+fn within_reach(candidates: &Candidates, motion: &Motion) -> usize {
+    candidates
+        .detections
+        .iter()
+        .filter(|candidate| {
+            let moved = motion.apply(candidate.point);
+            candidates
+                .near(candidate, moved)
+                .iter()
+                .any(|&(_, point, landmark_reach)| {
+                    in_reach(moved, candidate.reach, point, landmark_reach)
+                })
+        })
+        .count()
 }
 
 /// The one-to-one correspondences (nearest first, by [`Separation`] distance) that `motion`
@@ -800,20 +961,16 @@ fn matches(candidates: &Candidates, motion: &Motion) -> (Vec<(usize, usize)>, f6
     let mut close: Vec<(f64, usize, usize, f64)> = Vec::new();
     for candidate in &candidates.detections {
         let (i, grown, reach) = (candidate.detection, &candidate.grown, candidate.reach);
-        let [mx, my] = motion.apply(candidate.point);
+        let moved = motion.apply(candidate.point);
         let mut turned = None;
-        for &(j, [x, y], landmark_reach) in &candidates.alike[candidate.alike.clone()] {
-            let (dx, dy) = (mx - x, my - y);
-            // Beyond both placements' reach the pair is off whatever their shapes; most pairs
-            // are, and the test needs no ellipse.
-            let bound = reach + landmark_reach;
-            if dx * dx + dy * dy > bound * bound * (1.0 + 1e-9) {
+        for &(j, point, landmark_reach) in candidates.near(candidate, moved) {
+            if !in_reach(moved, reach, point, landmark_reach) {
                 continue;
             }
             let turned =
                 *turned.get_or_insert_with(|| turned_shape(grown, [motion.cos, motion.sin]));
             let separation = separation_of(
-                Vector2::new(dx, dy),
+                Vector2::new(moved[0] - point[0], moved[1] - point[1]),
                 &bound_of_sum(&turned, &candidates.grown[j]),
             );
             if separation.within() {
@@ -821,8 +978,8 @@ fn matches(candidates: &Candidates, motion: &Motion) -> (Vec<(usize, usize)>, f6
             }
         }
     }
-    // Stable: ties stay in (detection, landmark) order.
-    close.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Ties in (detection, landmark) order, whatever order the look-alikes are listed in.
+    close.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
     let mut used_i = Vec::new();
     let mut used_j = Vec::new();
     let mut out = Vec::new();
@@ -925,6 +1082,103 @@ pub(super) mod tests {
         let mut few = seen_from(at, 1.0, 0.0);
         few.landmarks.truncate(MIN_INLIERS - 1);
         assert!(displacement(&earlier, &few).is_none());
+    }
+
+    /// [`decisive`], scoring only the hypotheses whose bound comes within the margin of the best
+    /// score, decides as scoring every one does: on fields scattered and on grids, sharing a
+    /// few to most rocks with the frame, placed a little to far off, among look-alikes (a
+    /// fixed pseudo-random sequence). Every bound holds its hypothesis' inliers and score, so
+    /// those `significant` leaves unscored have too few inliers. (Skipping hypotheses whose
+    /// bound is half a point higher than this allows fails the test.)
+    #[test]
+    fn deciding_on_bounds_decides_as_scoring_every_hypothesis() {
+        let mut state = 11u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut decided, mut undecided, mut unscored) = (0, 0, 0);
+        for trial in 0..300 {
+            // Every other field a grid of rocks 3 m apart: a motion one step off pairs nearly
+            // as many, and the margin decides.
+            let rocks: Vec<[f64; 2]> = (0..16)
+                .map(|k| match trial % 2 {
+                    0 => [20.0 * (next() - 0.5), 20.0 * (next() - 0.5)],
+                    _ => [
+                        3.0 * (k % 4) as f64 + 0.05 * next(),
+                        3.0 * (k / 4) as f64 + 0.05 * next(),
+                    ],
+                })
+                .collect();
+            let frame = Frame {
+                accumulated: false,
+                departed: Vec::new(),
+                unmapped: Vec::new(),
+                landmarks: rocks
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &p)| {
+                        (
+                            k as LandmarkId,
+                            Placed::along(p, 6.3 * next(), 0.2 + next(), 0.1),
+                        )
+                    })
+                    .collect(),
+            };
+            // The station sees the first `shared` rocks, each `error` metres off, from 3 m
+            // away turned by `angle`, and ten other rocks.
+            let (shared, error, angle) = (2 + trial % 8, next() * next(), 6.3 * next());
+            let (sin, cos) = angle.sin_cos();
+            let mut current: Vec<Option<Placed>> = Vec::new();
+            for k in 0..shared + 10 {
+                let [x, y] = match rocks.get(k).filter(|_| k < shared) {
+                    Some(p) => [
+                        p[0] - 3.0 + error * (next() - 0.5),
+                        p[1] + error * (next() - 0.5),
+                    ],
+                    None => [20.0 * (next() - 0.5), 20.0 * (next() - 0.5)],
+                };
+                let point = [cos * x + sin * y, -sin * x + cos * y];
+                current.push(Some(Placed::along(point, 6.3 * next(), 0.2 + next(), 0.1)));
+            }
+            let all: Vec<(usize, usize)> = (0..current.len())
+                .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
+                .filter(|&(i, j)| i % shared == j || (i + 3 * j) % 4 == 0)
+                .collect();
+            let candidates = Candidates::new(&current, &frame, &all);
+            let mut every = hypotheses(&current, &frame, &all, &candidates);
+            let fits: Vec<&Fit> = every.iter_mut().map(|h| h.scored(&candidates)).collect();
+            let best = fits.iter().max_by(|a, b| a.score.total_cmp(&b.score));
+            let expected = best.and_then(|best| {
+                let runner_up = fits
+                    .iter()
+                    .filter(|h| !same_assignment(&h.inliers, &best.inliers))
+                    .map(|h| h.score)
+                    .fold(0.0, f64::max);
+                (best.inliers.len() >= MIN_INLIERS && best.score >= runner_up + MARGIN)
+                    .then(|| best.inliers.clone())
+            });
+            for h in &every {
+                let fit = h.fit.as_ref().expect("scored");
+                assert!(fit.inliers.len() <= h.most && fit.score <= h.most as f64);
+            }
+            let mut bounded = hypotheses(&current, &frame, &all, &candidates);
+            assert_eq!(
+                decisive(&mut bounded, &candidates),
+                expected,
+                "trial {trial}"
+            );
+            decided += expected.is_some() as usize;
+            undecided += expected.is_none() as usize;
+            unscored += bounded.iter().filter(|h| h.fit.is_none()).count();
+        }
+        assert!(
+            decided > 10 && undecided > 10,
+            "{decided} decided, {undecided} not"
+        );
+        assert!(unscored > 1000, "{unscored} hypotheses left unscored");
     }
 
     /// The table-driven [`matches`] keeps exactly the pairs, in the order, that testing every
@@ -1172,12 +1426,11 @@ pub(super) mod tests {
         let all: Vec<(usize, usize)> = (0..current.len())
             .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
             .collect();
-        assert!(decisive(&hypotheses(
-            &current,
-            &frame,
-            &all,
-            &Candidates::new(&current, &frame, &all)
-        ))
+        let candidates = Candidates::new(&current, &frame, &all);
+        assert!(decisive(
+            &mut hypotheses(&current, &frame, &all, &candidates),
+            &candidates
+        )
         .is_none());
         let registration = register(&current, &frame, &alike, &alike).expect("registers");
         let mut pairs = registration.pairs;
@@ -1194,14 +1447,11 @@ pub(super) mod tests {
             .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
             .collect();
         let truth = [(0, 0), (1, 1), (2, 2), (3, 3)];
-        assert!(hypotheses(
-            &current,
-            &frame,
-            &all,
-            &Candidates::new(&current, &frame, &all)
-        )
-        .iter()
-        .any(|h| h.inliers.len() >= MIN_INLIERS && same_assignment(&h.inliers, &truth)));
+        let candidates = Candidates::new(&current, &frame, &all);
+        assert!(hypotheses(&current, &frame, &all, &candidates)
+            .iter_mut()
+            .map(|h| h.scored(&candidates))
+            .any(|h| h.inliers.len() >= MIN_INLIERS && same_assignment(&h.inliers, &truth)));
         let alike = |_: usize, _: LandmarkId| true;
         assert_eq!(register(&current, &frame, &alike, &alike), None);
     }
