@@ -38,6 +38,7 @@
 
 pub mod agreement;
 pub mod audit;
+mod disc_grid;
 mod gallery;
 mod placement;
 mod recency;

@@ -9,6 +9,7 @@
 //! mutual distances agree; the one with most consistent correspondences wins. This only
 //! *proposes*: the qualitative test of 000 §VI-C decides (`super::associate`).
 
+use super::disc_grid::DiscGrid;
 use super::placement::{bound_of_sum, separation_of, turned_shape, Placed, Separation};
 use super::significance::Chance;
 use crate::ranging::Ray;
@@ -827,9 +828,9 @@ impl Motion {
 struct Candidates {
     /// Detections with a placement and a look-alike in the frame.
     detections: Vec<Candidate>,
-    /// Each detection's look-alike landmarks in turn, sorted by x: the landmark's index into
-    /// the frame's landmarks, its coordinates and its grown placement's reach, side by side so
-    /// that the distance test runs over them without looking up the others.
+    /// Each detection's look-alike landmarks in turn: the landmark's index into the frame's
+    /// landmarks, its coordinates and its grown placement's reach, side by side so that the
+    /// distance test runs over them without looking up the others.
     alike: Vec<(usize, [f64; 2], f64)>,
     /// The frame's landmarks' placements grown by half the slack.
     grown: Vec<Matrix2<f64>>,
@@ -845,19 +846,9 @@ struct Candidate {
     reach: f64,
     /// Where its look-alikes lie in [`Candidates::alike`].
     alike: std::ops::Range<usize>,
-    /// Its widest reach to one of them (both grown placements' reach), a little wide.
-    widest: f64,
-    /// Its look-alikes in buckets by x ([`Candidate::bucket`]): `starts[k]` is where bucket
-    /// `k` begins among them, and the last is their count.
-    starts: Vec<usize>,
-}
-
-impl Candidate {
-    /// The bucket of `x`, in steps of `widest` from bucket 1 at the first look-alike's x
-    /// (`first`), as a number: below 0 left of bucket 0, NaN for a NaN `x`.
-    fn bucket(&self, first: f64, x: f64) -> f64 {
-        (x - first) / self.widest + 1.0
-    }
+    /// Its look-alikes' reach (both grown placements'), a little wide, around each: where it
+    /// may lie to be one of them.
+    reaches: DiscGrid,
 }
 
 impl Candidates {
@@ -880,30 +871,21 @@ impl Candidates {
                     grown: p.grown(half),
                     reach: p.reach() + half,
                     alike: alike.len()..alike.len(),
-                    widest: 0.0,
-                    starts: Vec::new(),
+                    reaches: DiscGrid::new(&[]),
                 });
             }
             let q = frame.landmarks[j].1;
-            let landmark_reach = q.reach() + half;
-            alike.push((j, q.point, landmark_reach));
-            let detection = detections.last_mut().expect("pushed above");
-            detection.alike.end = alike.len();
-            // Wider than the reach by far more than rounding, so that the buckets of
-            // [`Candidates::near`] never leave out a pair that [`in_reach`] takes.
-            detection.widest = detection
-                .widest
-                .max((detection.reach + landmark_reach) * (1.0 + 1e-6));
+            alike.push((j, q.point, q.reach() + half));
+            detections.last_mut().expect("pushed above").alike.end = alike.len();
         }
         for detection in &mut detections {
-            let listed = &mut alike[detection.alike.clone()];
-            listed.sort_by(|a, b| a.1[0].total_cmp(&b.1[0]));
-            let first = listed[0].1[0];
-            let bucket = |a: &(usize, [f64; 2], f64)| detection.bucket(first, a.1[0]) as usize;
-            let last = bucket(&listed[listed.len() - 1]);
-            detection.starts = (0..=last + 1)
-                .map(|k| listed.partition_point(|a| bucket(a) < k))
+            // Wider than the reach by far more than rounding, so that the grid never leaves
+            // out a pair that [`in_reach`] takes.
+            let reaches: Vec<([f64; 2], f64)> = alike[detection.alike.clone()]
+                .iter()
+                .map(|&(_, point, reach)| (point, (detection.reach + reach) * (1.0 + 1e-6)))
                 .collect();
+            detection.reaches = DiscGrid::new(&reaches);
         }
         Candidates {
             detections,
@@ -912,19 +894,19 @@ impl Candidates {
         }
     }
 
-    /// The look-alikes of `candidate` that it may reach from `moved`: those in the bucket of
-    /// `moved`'s x and the two beside it, which hold every look-alike within its widest reach
-    /// in x (under most motions a detection lands near few of its look-alikes, or none).
-    fn near(&self, candidate: &Candidate, moved: [f64; 2]) -> &[(usize, [f64; 2], f64)] {
+    /// The look-alikes of `candidate` that it may reach from `moved`, a few more than it
+    /// does (under most motions a detection lands near few of its look-alikes, or none).
+    fn near<'c>(
+        &'c self,
+        candidate: &'c Candidate,
+        moved: [f64; 2],
+    ) -> impl Iterator<Item = &'c (usize, [f64; 2], f64)> {
         let listed = &self.alike[candidate.alike.clone()];
-        let last = candidate.starts.len() - 2;
-        let k = candidate.bucket(listed[0].1[0], moved[0]);
-        // A degenerate motion (NaN) reaches nothing.
-        if k.is_nan() || k < 0.0 || k as usize > last + 1 {
-            return &[];
-        }
-        let k = k as usize;
-        &listed[candidate.starts[k.saturating_sub(1)]..candidate.starts[(k + 1).min(last) + 1]]
+        candidate
+            .reaches
+            .near(moved)
+            .iter()
+            .map(move |&k| &listed[k])
     }
 }
 
@@ -947,7 +929,6 @@ fn within_reach(candidates: &Candidates, motion: &Motion) -> usize {
             let moved = motion.apply(candidate.point);
             candidates
                 .near(candidate, moved)
-                .iter()
                 .any(|&(_, point, landmark_reach)| {
                     in_reach(moved, candidate.reach, point, landmark_reach)
                 })
