@@ -1065,6 +1065,18 @@ pub(super) mod tests {
         assert!(displacement(&earlier, &few).is_none());
     }
 
+    /// A fixed pseudo-random sequence, uniform over [0, 1), from `seed` (a linear congruential
+    /// generator: the tests' fields are the same on every machine).
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// [`decisive`], scoring only the hypotheses whose bound comes within the margin of the best
     /// score, decides as scoring every one does: on fields scattered and on grids, sharing a
     /// few to most rocks with the frame, placed a little to far off, among look-alikes (a
@@ -1073,13 +1085,7 @@ pub(super) mod tests {
     /// bound is half a point higher than this allows fails the test.)
     #[test]
     fn deciding_on_bounds_decides_as_scoring_every_hypothesis() {
-        let mut state = 11u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(11);
         let (mut decided, mut undecided, mut unscored) = (0, 0, 0);
         for trial in 0..300 {
             // Every other field a grid of rocks 3 m apart: a motion one step off pairs nearly
@@ -1167,13 +1173,7 @@ pub(super) mod tests {
     /// pseudo-random sequence), some look-alikes, motions of every size.
     #[test]
     fn matches_from_the_table_are_those_of_every_correspondence_tested() {
-        let mut state = 7u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(7);
         // Discs and ellipses of every direction, some long and thin as far rocks' are.
         let mut place = |spread: f64| {
             let point = [spread * (next() - 0.5), spread * (next() - 0.5)];
