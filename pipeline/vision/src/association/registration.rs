@@ -1119,8 +1119,9 @@ pub(super) mod tests {
             let (shared, error, angle) = (2 + trial % 8, next() * next(), 6.3 * next());
             let (sin, cos) = angle.sin_cos();
             let mut current: Vec<Option<Placed>> = Vec::new();
-            for k in 0..shared + 10 {
-                let [x, y] = match rocks.get(k).filter(|_| k < shared) {
+            let others = std::iter::repeat_n(None, 10);
+            for seen in rocks[..shared].iter().map(Some).chain(others) {
+                let [x, y] = match seen {
                     Some(p) => [
                         p[0] - 3.0 + error * (next() - 0.5),
                         p[1] + error * (next() - 0.5),
