@@ -12,7 +12,6 @@
 //! colour test found is a rock of its own.
 
 use super::components::{bounds, Component};
-use std::collections::HashSet;
 
 /// Columns the raised pixels joined to `blob` (unwrapped (column, row) pixels of a band `w`
 /// wide and `rows` high) reach before and after the blob's own columns, through pixels
@@ -35,7 +34,10 @@ pub(super) fn beyond(
         first - limit..=last + limit,
         (top - i64::from(rise)).max(0)..=(bottom + 1).min(rows as i64 - 1),
     );
-    let mut seen = HashSet::new();
+    // Pixels reached, over the searched rows and columns (wrapped when the columns go round
+    // the panorama).
+    let span = (columns.end() - columns.start() + 1).min(w as i64);
+    let mut seen = vec![false; span as usize * (row_range.end() - row_range.start() + 1) as usize];
     let mut stack: Vec<(i64, i64)> = blob
         .iter()
         .map(|&(c, r)| (i64::from(c), i64::from(r)))
@@ -47,9 +49,12 @@ pub(super) fn beyond(
                 continue;
             }
             let i = nr as usize * w + nc.rem_euclid(w as i64) as usize;
-            if mask[i] != 0 || !raised(nc, nr) || !seen.insert(i) {
+            let slot = ((nr - row_range.start()) * span + (nc - columns.start()).rem_euclid(span))
+                as usize;
+            if mask[i] != 0 || seen[slot] || !raised(nc, nr) {
                 continue;
             }
+            seen[slot] = true;
             low = low.min(nc);
             high = high.max(nc);
             stack.push((nc, nr));

@@ -16,6 +16,8 @@
 use crate::calib::Calibration;
 use kornia_imgproc::filter::kernels::gaussian_kernel_1d;
 use rayon::prelude::*;
+use std::ops::Range;
+use std::sync::OnceLock;
 
 /// Half-size of the matching window, pixels.
 const RADIUS: usize = 2;
@@ -23,7 +25,7 @@ const RADIUS: usize = 2;
 /// A pixel is textured enough for the test when its cost against itself shifted by
 /// [`SELF_SHIFT`] exceeds this many times the band's median matching cost (most of the band is
 /// soil matched at its own shift: the median is the matching noise of the images, whatever
-/// their noise, blur or compression) …
+/// their noise, blur or compression; [`GroundTest`] samples it) …
 const NOISE_MULTIPLE: f32 = 3.0;
 
 /// … and this many luminance levels (of `r + g + b`) per pixel: a noise-free render matches
@@ -41,6 +43,10 @@ const MISMATCH_RATIO: f32 = 0.5;
 /// column of shift is absorbed by matching at the two integer shifts around the ground's).
 const TOLERANCE_COLUMNS: f64 = 1.5;
 
+/// Columns a neighbourhood is shifted against itself to tell whether it is textured enough
+/// for the test: past [`TOLERANCE_COLUMNS`].
+const SELF_SHIFT: isize = 2;
+
 /// What the stereo test says of one pixel of the ground band.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Stance {
@@ -53,90 +59,251 @@ pub(super) enum Stance {
     Raised,
 }
 
-/// The stance of each pixel of the ground band (`own.len() / width` rows from image row
-/// `top`), given the luminance (`r + g + b`) of both panoramas' bands; `direction` is the
-/// other camera's column step per unit of shift.
-pub(super) fn stances(
-    own: &[u16],
-    other: &[u16],
-    width: usize,
-    top: usize,
-    calib: &Calibration,
-    direction: isize,
-) -> Vec<Stance> {
-    let rows = own.len() / width;
-    let (own, other) = rayon::join(|| smoothed(own, width), || smoothed(other, width));
-    let (own, other) = (&own, &other);
-    let mut cost = vec![0f32; own.len()];
-    let mut texture = vec![0f32; own.len()];
-    // Rows in parallel: each is its own windows' sums.
-    cost.par_chunks_mut(width)
-        .zip(texture.par_chunks_mut(width))
-        .enumerate()
-        .for_each(|(y, (out, texture))| {
-            let shift = ground_shift(calib, (top + y) as f64 + 0.5);
-            let (ya, yb) = (y.saturating_sub(RADIUS), (y + RADIUS + 1).min(rows));
-            let (own_band, other_band) =
-                (&own[ya * width..yb * width], &other[ya * width..yb * width]);
-            out.fill(f32::INFINITY);
-            for s in [shift.floor(), shift.ceil()] {
-                let sums = window_costs(own_band, other_band, width, direction * s as isize);
-                for (o, c) in out.iter_mut().zip(sums) {
-                    *o = o.min(c);
-                }
-            }
-            // The same neighbourhood against itself shifted past the tolerance: how much a
-            // mismatch of the shift would cost.
-            texture.copy_from_slice(&window_costs(own_band, own_band, width, SELF_SHIFT));
-        });
-    let threshold = (NOISE_MULTIPLE * median(&cost)).max(MIN_COST);
+/// A stereo pair's ground bands: the luminance (`r + g + b`) of the rows from image row `top`
+/// down, `width` wide, of the panorama tested (`own`) and of its partner (`other`);
+/// `direction` is the partner's column step per unit of shift.
+#[derive(Clone, Copy)]
+pub(super) struct Bands<'a> {
+    pub own: &'a [u16],
+    pub other: &'a [u16],
+    pub width: usize,
+    pub top: usize,
+    pub calib: &'a Calibration,
+    pub direction: isize,
+}
+
+impl Bands<'_> {
+    fn rows(&self) -> usize {
+        self.own.len() / self.width
+    }
+}
+
+/// The stance of each pixel of the ground band, the texture threshold from the matching
+/// noise of the whole band.
+pub(super) fn stances(bands: &Bands) -> Vec<Stance> {
+    let Costs { cost, texture } = band_costs(bands);
+    let threshold = texture_threshold(cost.clone());
     cost.into_iter()
         .zip(texture)
-        .map(|(c, t)| {
-            if t <= threshold {
-                Stance::Unknown
-            } else if c > MISMATCH_RATIO * t {
-                Stance::Raised
-            } else {
-                Stance::Ground
-            }
-        })
+        .map(|(c, t)| stance(c, t, threshold))
         .collect()
 }
 
-/// Rows above and below a pixel that its stance depends on: the matching window's and the
-/// smoothing's.
-pub(super) const READ_ROWS: usize = RADIUS + SMOOTHING_REACH;
+/// [`Costs`] of the whole band, tested in strips of rows in parallel.
+fn band_costs(bands: &Bands) -> Costs {
+    let rows = bands.rows();
+    let strips: Vec<Costs> = (0..rows.div_ceil(STRIP_ROWS))
+        .into_par_iter()
+        .map(|i| {
+            rect_costs(
+                bands,
+                i * STRIP_ROWS..((i + 1) * STRIP_ROWS).min(rows),
+                0..bands.width,
+            )
+        })
+        .collect();
+    let (cost, texture) = strips
+        .into_iter()
+        .flat_map(|s| s.cost.into_iter().zip(s.texture))
+        .unzip();
+    Costs { cost, texture }
+}
 
-/// Columns a neighbourhood is shifted against itself to tell whether it is textured enough
-/// for the test: past [`TOLERANCE_COLUMNS`].
-const SELF_SHIFT: isize = 2;
+/// The stereo test of a ground band, run tile by tile where it is asked (a search around a
+/// few blobs reads a tenth of the band): each pixel's costs are those [`stances`] finds, the
+/// texture threshold is from a sample of the band's matching noise.
+pub(super) struct GroundTest<'a> {
+    tiles: Tiles<'a>,
+    threshold: f32,
+}
 
-/// Mean absolute difference, per pixel of a row, between the window of `a` around it and the
-/// window of `b` shifted by `offset` columns; `a` and `b` hold the window's rows (`width`
-/// each, the middle one the row's), columns wrap at the seam.
-fn window_costs(a: &[f32], b: &[f32], width: usize, offset: isize) -> Vec<f32> {
-    let rows = a.len() / width;
-    let mut column_sums = vec![0f32; width];
-    let start = offset.rem_euclid(width as isize) as usize;
-    let split = width - start;
-    for (ra, rb) in a.chunks_exact(width).zip(b.chunks_exact(width)) {
-        // Column x of `a` against column x + start of `b`, wrapping at the seam: two
-        // contiguous runs, which compile to vector instructions (one chained run did not).
-        let (sums_before, sums_after) = column_sums.split_at_mut(split);
-        let (ra_before, ra_after) = ra.split_at(split);
-        for ((sum, p), q) in sums_before.iter_mut().zip(ra_before).zip(&rb[start..]) {
-            *sum += (p - q).abs();
+impl<'a> GroundTest<'a> {
+    /// Tests the tiles of the noise sample ([`SAMPLE_STRIDE`]) at once, in parallel, for
+    /// the texture threshold.
+    pub(super) fn new(bands: Bands<'a>) -> Self {
+        let tiles = Tiles::new(bands);
+        let sampled: Vec<f32> = (0..tiles.costs.len())
+            .into_par_iter()
+            .step_by(SAMPLE_STRIDE)
+            .flat_map_iter(|t| tiles.costs(t).cost.clone())
+            .collect();
+        GroundTest {
+            tiles,
+            threshold: texture_threshold(sampled),
         }
-        for ((sum, p), q) in sums_after.iter_mut().zip(ra_after).zip(&rb[..start]) {
+    }
+
+    /// The stance of the pixel at `column` and `row` of the band.
+    pub(super) fn stance(&self, column: usize, row: usize) -> Stance {
+        let t = row / TILE_ROWS * self.tiles.across + column / TILE_COLUMNS;
+        let (x0, y0) = self.tiles.corner(t);
+        let tile_width = TILE_COLUMNS.min(self.tiles.bands.width - x0);
+        let i = (row - y0) * tile_width + column - x0;
+        let costs = self.tiles.costs(t);
+        stance(costs.cost[i], costs.texture[i], self.threshold)
+    }
+}
+
+/// A band's tiles, row after row of them, each tested when first read.
+struct Tiles<'a> {
+    bands: Bands<'a>,
+    /// Tiles along a row of the band.
+    across: usize,
+    costs: Vec<OnceLock<Costs>>,
+}
+
+impl<'a> Tiles<'a> {
+    fn new(bands: Bands<'a>) -> Self {
+        let across = bands.width.div_ceil(TILE_COLUMNS);
+        let down = bands.rows().div_ceil(TILE_ROWS);
+        Tiles {
+            bands,
+            across,
+            costs: (0..across * down).map(|_| OnceLock::new()).collect(),
+        }
+    }
+
+    /// The column and row of tile `t`'s first pixel.
+    fn corner(&self, t: usize) -> (usize, usize) {
+        (t % self.across * TILE_COLUMNS, t / self.across * TILE_ROWS)
+    }
+
+    fn costs(&self, t: usize) -> &Costs {
+        self.costs[t].get_or_init(|| {
+            let (x, y) = self.corner(t);
+            rect_costs(
+                &self.bands,
+                y..(y + TILE_ROWS).min(self.bands.rows()),
+                x..(x + TILE_COLUMNS).min(self.bands.width),
+            )
+        })
+    }
+}
+
+/// Rows of a strip of [`band_costs`]: a few strips a core, each smoothing a few rows more than
+/// it tests.
+const STRIP_ROWS: usize = 64;
+
+/// Rows and columns of a tile of [`GroundTest`]: about the size of a far rock's search.
+const TILE_ROWS: usize = 16;
+const TILE_COLUMNS: usize = 64;
+
+/// [`GroundTest`] samples the matching noise over one tile in [`SAMPLE_STRIDE`], counted row
+/// after row of tiles: 31 is prime to the tiles across a row at every width in use, so the
+/// sample steps across the columns as it goes down every row of tiles (the noise of far ground
+/// near the horizon is not that of near ground). About 60 tiles at 4096 × 768: the median of
+/// tens of thousands of costs, most of them soil's, is the whole band's within a few
+/// hundredths, and a search around a few blobs need not test the rest.
+const SAMPLE_STRIDE: usize = 31;
+
+/// The texture a pixel needs for the test, from matching costs of the band.
+fn texture_threshold(mut sampled: Vec<f32>) -> f32 {
+    let noise = if sampled.is_empty() {
+        0.0
+    } else {
+        let mid = sampled.len() / 2;
+        *sampled.select_nth_unstable_by(mid, f32::total_cmp).1
+    };
+    (NOISE_MULTIPLE * noise).max(MIN_COST)
+}
+
+fn stance(cost: f32, texture: f32, threshold: f32) -> Stance {
+    if texture <= threshold {
+        Stance::Unknown
+    } else if cost > MISMATCH_RATIO * texture {
+        Stance::Raised
+    } else {
+        Stance::Ground
+    }
+}
+
+/// The matching costs of a rectangle of the band, row after row: each pixel's cost at the
+/// flat ground's shift and against itself shifted by [`SELF_SHIFT`] (its texture).
+struct Costs {
+    cost: Vec<f32>,
+    texture: Vec<f32>,
+}
+
+/// [`Costs`] of the band's `rows` and `columns`. Every pixel's costs are the same sums in the
+/// same order whatever rectangle holds it, so tiles and strips agree bit for bit.
+fn rect_costs(bands: &Bands, rows: Range<usize>, columns: Range<usize>) -> Costs {
+    let r = RADIUS as isize;
+    let (x0, x1) = (columns.start as isize, columns.end as isize);
+    // Each row's two integer shifts around the ground's, as column offsets in `other`.
+    let offsets: Vec<[isize; 2]> = rows
+        .clone()
+        .map(|y| {
+            let shift = ground_shift(bands.calib, (bands.top + y) as f64 + 0.5);
+            [shift.floor(), shift.ceil()].map(|s| bands.direction * s as isize)
+        })
+        .collect();
+    let (low, high) = offsets
+        .iter()
+        .flatten()
+        .fold((0, 0), |(l, h), &o| (l.min(o), h.max(o)));
+    let read = rows.start.saturating_sub(RADIUS)..(rows.end + RADIUS).min(bands.rows());
+    let own = smooth_region(
+        bands.own,
+        bands.width,
+        read.clone(),
+        x0 - r..x1 + r + SELF_SHIFT,
+    );
+    let other = smooth_region(bands.other, bands.width, read, x0 - r + low..x1 + r + high);
+    let n = columns.len() * rows.len();
+    let (mut cost, mut texture) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for (y, [a, b]) in rows.zip(offsets) {
+        let window = y.saturating_sub(RADIUS)..(y + RADIUS + 1).min(bands.rows());
+        let at = |offset| window_costs(&own, &other, window.clone(), x0..x1, offset);
+        cost.extend(at(a).into_iter().zip(at(b)).map(|(p, q)| p.min(q)));
+        texture.extend(window_costs(&own, &own, window, x0..x1, SELF_SHIFT));
+    }
+    Costs { cost, texture }
+}
+
+/// Smoothed values of a band over some of its rows and a range of unwrapped columns.
+struct Plane {
+    rows: Range<usize>,
+    x0: isize,
+    width: usize,
+    values: Vec<f32>,
+}
+
+impl Plane {
+    /// `n` values of row `y` from unwrapped column `x`.
+    fn run(&self, y: usize, x: isize, n: usize) -> &[f32] {
+        let start = (y - self.rows.start) * self.width + (x - self.x0) as usize;
+        &self.values[start..start + n]
+    }
+}
+
+/// Mean absolute difference, per column of `columns`, between the window of `a` around it
+/// and the window of `b` shifted by `offset` columns, over the `window` rows.
+fn window_costs(
+    a: &Plane,
+    b: &Plane,
+    window: Range<usize>,
+    columns: Range<isize>,
+    offset: isize,
+) -> Vec<f32> {
+    let r = RADIUS as isize;
+    let n = (columns.end - columns.start) as usize;
+    let span = n + 2 * RADIUS;
+    let mut column_sums = vec![0f32; span];
+    for y in window.clone() {
+        let ra = a.run(y, columns.start - r, span);
+        let rb = b.run(y, columns.start - r + offset, span);
+        for ((sum, p), q) in column_sums.iter_mut().zip(ra).zip(rb) {
             *sum += (p - q).abs();
         }
     }
-    let area = (rows * (2 * RADIUS + 1)) as f32;
-    window_sums(&column_sums)
-        .into_iter()
-        .map(|c| c / area)
-        .collect()
+    let mut sums = vec![0f32; n];
+    for k in 0..=2 * RADIUS {
+        for (s, c) in sums.iter_mut().zip(&column_sums[k..]) {
+            *s += c;
+        }
+    }
+    let area = (window.len() * (2 * RADIUS + 1)) as f32;
+    sums.into_iter().map(|s| s / area).collect()
 }
 
 /// Standard deviation (pixels) of the Gaussian both bands are smoothed with before matching:
@@ -149,45 +316,50 @@ const SMOOTHING_PX: f32 = 1.0;
 /// weight.
 const SMOOTHING_REACH: usize = 2 * SMOOTHING_PX as usize;
 
-/// `band` (rows of `width`) smoothed by kornia's Gaussian kernel of [`SMOOTHING_PX`], wrapping
-/// at the seam and taking rows beyond the band as zero, as kornia's `gaussian_blur` would: the
-/// same sums in the same order. Written as two passes over whole rows, rows in parallel, which
-/// compile to vector instructions: kornia 0.2's separable filter tests every tap's bounds on
-/// one thread, 22 ms a band at 4096 × 768, half the stereo test's time in a navigator's step.
-fn smoothed(band: &[u16], width: usize) -> Vec<f32> {
+/// `band` (rows of `width`) smoothed by kornia's Gaussian kernel of [`SMOOTHING_PX`] at its
+/// `rows` and unwrapped `columns`, wrapping at the seam and taking rows beyond the band as
+/// zero, as kornia's `gaussian_blur` would: the same sums in the same order, whatever the
+/// region. Written as two passes over runs of a row, which compile to vector instructions:
+/// kornia 0.2's separable filter tests every tap's bounds, 22 ms a band at 4096 × 768.
+fn smooth_region(band: &[u16], width: usize, rows: Range<usize>, columns: Range<isize>) -> Plane {
     let kernel = gaussian_kernel_1d(2 * SMOOTHING_REACH + 1, SMOOTHING_PX);
     let pad = SMOOTHING_REACH;
-    let rows = band.len() / width;
-    let mut across = vec![0f32; band.len()];
-    across
-        .par_chunks_mut(width)
-        .zip(band.par_chunks(width))
-        .for_each(|(out, row)| {
-            let wrapped = |k: usize| f32::from(row[k % width]);
-            let padded: Vec<f32> = (0..width + 2 * pad)
-                .map(|k| wrapped(k + pad * width - pad))
-                .collect();
-            for (k, &weight) in kernel.iter().enumerate() {
-                for (o, &v) in out.iter_mut().zip(&padded[k..k + width]) {
-                    *o += v * weight;
-                }
-            }
-        });
-    let mut out = vec![0f32; band.len()];
-    out.par_chunks_mut(width).enumerate().for_each(|(y, out)| {
+    let band_rows = band.len() / width;
+    let n = (columns.end - columns.start) as usize;
+    let read = rows.start.saturating_sub(pad)..(rows.end + pad).min(band_rows);
+    let mut across = vec![0f32; read.len() * n];
+    for (y, out) in read.clone().zip(across.chunks_exact_mut(n)) {
+        let row = &band[y * width..(y + 1) * width];
+        let padded: Vec<f32> = (0..n + 2 * pad)
+            .map(|k| {
+                let x = columns.start + k as isize - pad as isize;
+                f32::from(row[x.rem_euclid(width as isize) as usize])
+            })
+            .collect();
         for (k, &weight) in kernel.iter().enumerate() {
-            let Some(from) = (y + k).checked_sub(pad).filter(|&r| r < rows) else {
-                continue;
-            };
-            for (o, &v) in out
-                .iter_mut()
-                .zip(&across[from * width..(from + 1) * width])
-            {
+            for (o, &v) in out.iter_mut().zip(&padded[k..k + n]) {
                 *o += v * weight;
             }
         }
-    });
-    out
+    }
+    let mut values = vec![0f32; rows.len() * n];
+    for (y, out) in rows.clone().zip(values.chunks_exact_mut(n)) {
+        for (k, &weight) in kernel.iter().enumerate() {
+            let Some(from) = (y + k).checked_sub(pad).filter(|&r| r < band_rows) else {
+                continue;
+            };
+            let from = &across[(from - read.start) * n..(from - read.start + 1) * n];
+            for (o, &v) in out.iter_mut().zip(from) {
+                *o += v * weight;
+            }
+        }
+    }
+    Plane {
+        rows,
+        x0: columns.start,
+        width: n,
+        values,
+    }
 }
 
 /// The contact row of a rock whose lowest raised pixel row ends at `raised_bottom` (the row
@@ -213,44 +385,10 @@ fn ground_shift(calib: &Calibration, row: f64) -> f64 {
     })
 }
 
-/// Sums of `2·RADIUS + 1` consecutive values around each column, wrapping at the seam.
-fn window_sums(values: &[f32]) -> Vec<f32> {
-    let w = values.len();
-    let at = |x: isize| values[x.rem_euclid(w as isize) as usize];
-    let r = RADIUS;
-    let mut sum: f32 = (-(r as isize)..=r as isize).map(at).sum();
-    // Indices wrap only near the seam; elsewhere they index directly (no division a column).
-    (0..w)
-        .map(|x| {
-            let out = sum;
-            let entering = if x + r + 1 < w {
-                values[x + r + 1]
-            } else {
-                at((x + r + 1) as isize)
-            };
-            let leaving = if x >= r {
-                values[x - r]
-            } else {
-                at(x as isize - r as isize)
-            };
-            sum += entering - leaving;
-            out
-        })
-        .collect()
-}
-
-fn median(values: &[f32]) -> f32 {
-    let mut finite: Vec<f32> = values.iter().copied().filter(|v| v.is_finite()).collect();
-    if finite.is_empty() {
-        return 0.0;
-    }
-    let mid = finite.len() / 2;
-    *finite.select_nth_unstable_by(mid, f32::total_cmp).1
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
     /// A quarter-size panorama (1024 × 192, horizon at row 75).
     fn calib() -> Calibration {
@@ -331,7 +469,14 @@ mod tests {
         let top = 76;
         let scene = scene(&calib, top);
         let w = 1024;
-        let stances = stances(&scene.left, &scene.right, w, top, &calib, -1);
+        let stances = stances(&Bands {
+            own: &scene.left,
+            other: &scene.right,
+            width: w,
+            top,
+            calib: &calib,
+            direction: -1,
+        });
         let share = |rows: std::ops::Range<usize>, cols: std::ops::Range<usize>, s: Stance| {
             let n = rows.len() * cols.len();
             let hits = rows
@@ -355,9 +500,8 @@ mod tests {
         assert!(share(shaded, b - 2..b + 2, Stance::Ground) > 0.9);
     }
 
-    /// A band thinner and narrower than the smoothing kernel and the window is still judged.
     /// kornia's `gaussian_blur` of the band padded by wrapping at the seam: the reference
-    /// [`smoothed`] must equal bit for bit.
+    /// [`smooth_region`] of the whole band must equal bit for bit.
     fn smoothed_by_kornia(band: &[u16], width: usize) -> Vec<f32> {
         use kornia_image::{Image, ImageSize};
         let pad = SMOOTHING_REACH;
@@ -394,7 +538,7 @@ mod tests {
             let band: Vec<u16> = (0..width * rows)
                 .map(|i| ((i * 7919 + i * i * 31) % 766) as u16)
                 .collect();
-            let ours = smoothed(&band, width);
+            let ours = smooth_region(&band, width, 0..rows, 0..width as isize).values;
             let theirs = smoothed_by_kornia(&band, width);
             assert!(
                 ours.iter()
@@ -406,12 +550,110 @@ mod tests {
         }
     }
 
+    /// A band of pseudo-random texture (levels below `amplitude`), and its partner: the same
+    /// texture `shift(row)` columns along, with noise of a tenth of the amplitude.
+    fn textured_bands(
+        width: usize,
+        rows: usize,
+        amplitude: u16,
+        shift: impl Fn(usize) -> usize,
+        seed: u64,
+    ) -> (Vec<u16>, Vec<u16>) {
+        let level = |i: usize, salt: u64| {
+            let mut h = seed ^ salt ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            h ^= h >> 31;
+            h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            h ^= h >> 29;
+            (h % u64::from(amplitude)) as u16
+        };
+        let own: Vec<u16> = (0..width * rows).map(|i| level(i, 1)).collect();
+        let other = (0..width * rows)
+            .map(|i| {
+                let (y, x) = (i / width, i % width);
+                own[y * width + (x + shift(y)) % width] + level(i, 2) / 10
+            })
+            .collect();
+        (own, other)
+    }
+
+    proptest! {
+        /// The tiles tested where they are read give every pixel the costs the whole band's
+        /// strips give it, bit for bit: bands of any size (tiles cut at its right edge, strips
+        /// at its bottom), either stereo direction, textures faint to rough.
+        #[test]
+        fn tiles_read_on_demand_cost_as_the_whole_band(
+            width in 1usize..300,
+            rows in 1usize..116,
+            amplitude in 1u16..766,
+            shift in 0usize..20,
+            rightwards in any::<bool>(),
+            seed in any::<u64>(),
+        ) {
+            let calib = calib();
+            let (own, other) = textured_bands(width, rows, amplitude, |_| shift, seed);
+            let bands = Bands {
+                own: &own,
+                other: &other,
+                width,
+                top: 76,
+                calib: &calib,
+                direction: if rightwards { 1 } else { -1 },
+            };
+            let whole = band_costs(&bands);
+            let tiles = GroundTest::new(bands);
+            for (i, (&c, &t)) in whole.cost.iter().zip(&whole.texture).enumerate() {
+                let expected = stance(c, t, tiles.threshold);
+                prop_assert_eq!(tiles.stance(i % width, i / width), expected, "pixel {}", i);
+            }
+        }
+    }
+
+    /// The sampled matching noise of a rough ground seen with noise is the whole band's within
+    /// 3 %, well above the threshold's floor: a full-size panorama (4096 × 768, horizon at row
+    /// 300) whose partner sees the ground at each row's shift.
+    #[test]
+    fn the_sampled_noise_is_the_whole_bands() {
+        let text = "[image]\nwidth = 4096\nheight = 768\n[azimuth]\ncolumn0_deg = 180.0\n\
+            direction = \"clockwise\"\n[elevation]\nhorizon_row = 300.0\nfocal_px = 652.0\n\
+            [mast]\nheight_m = 1.5\n[stereo]\nbaseline_m = 0.3\n";
+        let calib = Calibration::parse(text, "test").expect("valid");
+        let (width, top) = (4096, 301);
+        let rows = 768 - top;
+        // The partner (to the right: smaller columns) sees the ground at its row's shift.
+        let ground = |y: usize| {
+            let shift = ground_shift(&calib, (top + y) as f64 + 0.5).round() as usize;
+            width - shift % width
+        };
+        let (own, other) = textured_bands(width, rows, 600, ground, 11);
+        let bands = Bands {
+            own: &own,
+            other: &other,
+            width,
+            top,
+            calib: &calib,
+            direction: -1,
+        };
+        let whole = texture_threshold(band_costs(&bands).cost);
+        let sampled = GroundTest::new(bands).threshold;
+        assert!(whole > 2.0 * MIN_COST, "{whole}");
+        assert!((sampled / whole - 1.0).abs() < 0.03, "{sampled} vs {whole}");
+    }
+
+    /// A band thinner and narrower than the smoothing kernel and the window is still judged.
     #[test]
     fn a_tiny_band_is_judged_without_panic() {
         let calib = calib();
         for (w, rows) in [(1usize, 1usize), (3, 2), (8, 3)] {
             let band: Vec<u16> = (0..w * rows).map(|i| (i * 37 % 300) as u16).collect();
-            assert_eq!(stances(&band, &band, w, 150, &calib, -1).len(), w * rows);
+            let bands = Bands {
+                own: &band,
+                other: &band,
+                width: w,
+                top: 150,
+                calib: &calib,
+                direction: -1,
+            };
+            assert_eq!(stances(&bands).len(), w * rows);
         }
     }
 

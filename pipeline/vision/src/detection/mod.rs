@@ -259,10 +259,16 @@ fn detect_in(
         Some((_, Eye::Left)) => -towards,
         _ => towards,
     };
-    let stances = bands
-        .as_ref()
-        .filter(|_| luminance)
-        .map(|(own, other)| ground::stances(own, other, w, top, calib, direction));
+    let stances = bands.as_ref().filter(|_| luminance).map(|(own, other)| {
+        ground::stances(&ground::Bands {
+            own,
+            other,
+            width: w,
+            top,
+            calib,
+            direction,
+        })
+    });
     let pixels_rule = match (luminance, &stances) {
         (false, _) => PixelRule::Colour,
         (true, Some(stances)) => PixelRule::OffGround(stances),
@@ -371,78 +377,68 @@ fn detect_in(
     // In colour mode, how far each detected blob's rock may reach beyond what the colour test
     // found.
     if let Some((own, other)) = bands.as_ref().filter(|_| !luminance) {
-        let stereo = Stereo {
+        let bands = ground::Bands {
             own,
             other,
+            width: w,
             top,
-            direction,
             calib,
+            direction,
         };
-        reach_beyond(&mut detections, &blobs, mask.as_slice(), w, &stereo);
+        reach_beyond(&mut detections, &blobs, mask.as_slice(), bands);
     }
     detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
     detections
 }
 
-/// The ground bands of a stereo pair, for the stereo test ([`ground::stances`]).
-struct Stereo<'a> {
-    own: &'a [u16],
-    other: &'a [u16],
-    top: usize,
-    direction: isize,
-    calib: &'a Calibration,
-}
-
 /// Sets each detection's [`Detection::beyond_columns`]: the raised pixels joining its blob
-/// (`blobs`, components of the colour test's `mask`, `w` wide) beside it, on the sides where
-/// it ends the blob. The stereo test runs over the rows the searches may visit only.
+/// (`blobs`, components of the colour test's `mask`, as wide as the bands) beside it, on the sides where
+/// it ends the blob. The stereo test of `bands` runs over the tiles the searches visit only;
+/// blobs are searched in parallel.
 fn reach_beyond(
     detections: &mut [Detection],
     blobs: &[components::Component],
     mask: &[u8],
-    w: usize,
-    stereo: &Stereo,
+    bands: ground::Bands,
 ) {
+    if detections.is_empty() {
+        return;
+    }
+    let w = bands.width;
     let rows = mask.len() / w;
+    let test = ground::GroundTest::new(bands);
     let limits = |b: [u32; 4]| {
         (
             REACH_WIDTHS * (b[2] - b[0] + 1),
             REACH_HEIGHTS * (b[3] - b[1] + 1),
         )
     };
-    let Some((first, last)) = detections
-        .iter()
-        .filter_map(|d| bounds(&blobs[d.blob as usize]))
-        .map(|b| (b[1].saturating_sub(limits(b).1) as usize, b[3] as usize + 1))
-        .reduce(|(a0, a1), (b0, b1)| (a0.min(b0), a1.max(b1)))
-    else {
-        return;
-    };
-    // The rows searched, and those the test reads around them.
-    let r0 = first.saturating_sub(ground::READ_ROWS);
-    let r1 = (last + ground::READ_ROWS + 1).min(rows);
-    let stances = ground::stances(
-        &stereo.own[r0 * w..r1 * w],
-        &stereo.other[r0 * w..r1 * w],
-        w,
-        stereo.top + r0,
-        stereo.calib,
-        stereo.direction,
-    );
     let raised = |c: i64, r: i64| {
-        let row = usize::try_from(r).ok().and_then(|r| r.checked_sub(r0));
-        row.and_then(|row| stances.get(row * w + c.rem_euclid(w as i64) as usize))
-            == Some(&ground::Stance::Raised)
+        usize::try_from(r).is_ok_and(|r| {
+            r < rows && test.stance(c.rem_euclid(w as i64) as usize, r) == ground::Stance::Raised
+        })
     };
-    let mut reach = std::collections::HashMap::new();
+    let mut searched: Vec<u32> = detections.iter().map(|d| d.blob).collect();
+    searched.sort_unstable();
+    searched.dedup();
+    let reach: std::collections::HashMap<u32, [u32; 2]> = searched
+        .into_par_iter()
+        .filter_map(|blob| {
+            let pixels = &blobs[blob as usize];
+            let b = bounds(pixels)?;
+            Some((
+                blob,
+                extent::beyond(pixels, mask, w, rows, limits(b), raised),
+            ))
+        })
+        .collect();
     for detection in detections {
-        let blob = &blobs[detection.blob as usize];
-        let Some(b) = bounds(blob) else {
+        let (Some(&[before, after]), Some(b)) = (
+            reach.get(&detection.blob),
+            bounds(&blobs[detection.blob as usize]),
+        ) else {
             continue;
         };
-        let [before, after] = *reach
-            .entry(detection.blob)
-            .or_insert_with(|| extent::beyond(blob, mask, w, rows, limits(b), raised));
         detection.beyond_columns = [
             if detection.bbox[0] == b[0] { before } else { 0 },
             if detection.bbox[2] == b[2] { after } else { 0 },
