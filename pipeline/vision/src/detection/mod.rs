@@ -259,16 +259,17 @@ fn detect_in(
         Some((_, Eye::Left)) => -towards,
         _ => towards,
     };
-    let stances = bands.as_ref().filter(|_| luminance).map(|(own, other)| {
-        ground::stances(&ground::Bands {
-            own,
-            other,
-            width: w,
-            top,
-            calib,
-            direction,
-        })
+    let ground_bands = bands.as_ref().map(|(own, other)| ground::Bands {
+        own,
+        other,
+        width: w,
+        top,
+        calib,
+        direction,
     });
+    let stances = ground_bands
+        .filter(|_| luminance)
+        .map(|bands| ground::stances(&bands));
     let pixels_rule = match (luminance, &stances) {
         (false, _) => PixelRule::Colour,
         (true, Some(stances)) => PixelRule::OffGround(stances),
@@ -376,15 +377,7 @@ fn detect_in(
         .collect();
     // In colour mode, how far each detected blob's rock may reach beyond what the colour test
     // found.
-    if let Some((own, other)) = bands.as_ref().filter(|_| !luminance) {
-        let bands = ground::Bands {
-            own,
-            other,
-            width: w,
-            top,
-            calib,
-            direction,
-        };
+    if let Some(bands) = ground_bands.filter(|_| !luminance) {
         reach_beyond(&mut detections, &blobs, mask.as_slice(), bands);
     }
     detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
