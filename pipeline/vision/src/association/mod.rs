@@ -398,8 +398,7 @@ fn registrations<'f>(
                     .take(REGISTRATION_SEEDS)
                     .any(|c| c.0 == l)
             };
-            let registration = register(placed, frame, &alike, &closest)
-                .or_else(|| register(placed, frame, &alike, &closest_in_frame))?;
+            let registration = register(placed, frame, &alike, &[&closest, &closest_in_frame])?;
             Some((frame, registration))
         })
         .filter(|(frame, registration)| {
@@ -988,8 +987,8 @@ mod tests {
         let landmarks = frame(&FIELD[..4]);
         let loose = seen(0.3);
         let placed: Vec<Option<Placed>> = loose.1.detections.iter().map(|e| e.placed).collect();
-        let registration =
-            register(&placed, &landmarks, &|_, _| true, &|_, _| true).expect("the loose fit wins");
+        let registration = register(&placed, &landmarks, &|_, _| true, &[&|_, _| true])
+            .expect("the loose fit wins");
         assert_eq!(registration.pairs.len(), 4);
         assert!(registration.nfa >= SIGNIFICANT_NFA, "{}", registration.nfa);
         let decisions = associate_station(&loose, std::slice::from_ref(&landmarks));

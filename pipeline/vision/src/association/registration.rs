@@ -104,37 +104,78 @@ const CLUSTER_RADIUS_M: f64 = 3.0;
 /// most look-alike correspondences (`alike(detection, landmark)`), if it explains at least
 /// [`MIN_INLIERS`] and either clearly more than any motion that differs from it, or so tightly
 /// that chance cannot explain it while every differing motion's fit is what chance gives
-/// ([`super::significance`]). Motions are hypothesised only from pairs of the closest
-/// look-alikes (`seed`), which keeps the search quadratic in the detections rather than in all
+/// ([`super::significance`]). Motions are hypothesised only from pairs of seeds, the closest
+/// look-alikes, which keeps the search quadratic in the detections rather than in all
 /// look-alike pairs.
+///
+/// The sets of seeds (`seed_sets`, each a test of a correspondence) are tried in turn, each on
+/// its own terms (its own count of hypotheses in the null model), and the first that registers
+/// gives the registration. A hypothesis that several sets share is scored once: a navigator
+/// registers against every station of the run, most of them out of sight, and there the second
+/// set re-scored all of the first set's hypotheses (marsyard seed 7: two in five of its own).
 pub fn register(
     current: &[Option<Placed>],
     frame: &Frame,
     alike: &dyn Fn(usize, LandmarkId) -> bool,
-    seed: &dyn Fn(usize, LandmarkId) -> bool,
+    seed_sets: &[&dyn Fn(usize, LandmarkId) -> bool],
 ) -> Option<Registration> {
     let correspondences: Vec<(usize, usize)> = (0..current.len())
         .filter(|&i| current[i].is_some())
         .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
         .filter(|&(i, j)| alike(i, frame.landmarks[j].0))
         .collect();
+    let in_set = |set: &dyn Fn(usize, LandmarkId) -> bool, (i, j): (usize, usize)| {
+        set(i, frame.landmarks[j].0)
+    };
     let seeds: Vec<(usize, usize)> = correspondences
         .iter()
         .copied()
-        .filter(|&(i, j)| seed(i, frame.landmarks[j].0))
+        .filter(|&c| seed_sets.iter().any(|set| in_set(*set, c)))
         .collect();
     let candidates = Candidates::new(current, frame, &correspondences);
-    let mut hypotheses = hypotheses(current, frame, &seeds, &candidates);
-    let chance = chance(frame, &seeds, &correspondences);
-    let inliers = decisive(&mut hypotheses, &candidates)
-        .or_else(|| significant(current, frame, &mut hypotheses, &candidates, &chance))?;
-    let nfa = core(current, frame, &inliers, &chance).0;
-    let (motion, pairs) = unambiguous(current, frame, &inliers);
-    (pairs.len() >= MIN_INLIERS).then(|| Registration {
-        pairs,
-        motion: [motion.cos, motion.sin, motion.shift[0], motion.shift[1]],
-        nfa,
-    })
+    let mut hypothesised: Vec<Hypothesis> = Vec::new();
+    // Whether the seed pair, by index into the seeds, was tried for an earlier set.
+    let mut paired = vec![false; seeds.len() * seeds.len()];
+    for set in seed_sets {
+        let member: Vec<bool> = seeds.iter().map(|&c| in_set(*set, c)).collect();
+        let pairs: Vec<(usize, usize)> = seed_pairs(seeds.len())
+            .filter(|&(x, y)| member[x] && member[y] && !paired[x * seeds.len() + y])
+            .collect();
+        for &(x, y) in &pairs {
+            paired[x * seeds.len() + y] = true;
+        }
+        hypothesised.extend(hypotheses(current, frame, &seeds, pairs, &candidates));
+        // In seed-pair order whichever set hypothesised them first, so that ties are broken
+        // as for this set's hypotheses alone.
+        let mut tried: Vec<usize> = (0..hypothesised.len())
+            .filter(|&k| member[hypothesised[k].seeds.0] && member[hypothesised[k].seeds.1])
+            .collect();
+        tried.sort_unstable_by_key(|&k| hypothesised[k].seeds);
+        let seeded = member.iter().filter(|&&m| m).count();
+        let chance = chance(frame, seeded, &correspondences);
+        let Some(inliers) = decisive(&mut hypothesised, &tried, &candidates).or_else(|| {
+            significant(
+                current,
+                frame,
+                &mut hypothesised,
+                &tried,
+                &candidates,
+                &chance,
+            )
+        }) else {
+            continue;
+        };
+        let nfa = core(current, frame, &inliers, &chance).0;
+        let (motion, pairs) = unambiguous(current, frame, &inliers);
+        if pairs.len() >= MIN_INLIERS {
+            return Some(Registration {
+                pairs,
+                motion: [motion.cos, motion.sin, motion.shift[0], motion.shift[1]],
+                nfa,
+            });
+        }
+    }
+    None
 }
 
 /// One motion hypothesis, scored only when its score can matter: most hypotheses cannot come
@@ -142,6 +183,8 @@ pub fn register(
 /// registration's time.
 struct Hypothesis {
     motion: Motion,
+    /// The two seed correspondences it was hypothesised from, by index into the seeds.
+    seeds: (usize, usize),
     /// How many detections the motion brings within reach of a look-alike ([`within_reach`]):
     /// no more can be its inliers, so its score is no higher.
     most: usize,
@@ -166,12 +209,14 @@ impl Hypothesis {
     }
 }
 
-/// Every motion hypothesised from two seed correspondences whose distances agree, with how
-/// many correspondences it may fit at most; none is scored yet.
+/// The motions hypothesised from `pairs` of `seeds` (indices into them, first below second)
+/// whose distances agree, with how many correspondences each may fit at most; none is scored
+/// yet.
 fn hypotheses(
     current: &[Option<Placed>],
     frame: &Frame,
     seeds: &[(usize, usize)],
+    pairs: impl IntoIterator<Item = (usize, usize)>,
     candidates: &Candidates,
 ) -> Vec<Hypothesis> {
     let detection = |i: usize| current[i].expect("seeds are placed");
@@ -180,31 +225,36 @@ fn hypotheses(
     let between_landmarks =
         Baselines::new(seeds.iter().map(|s| s.1), frame.landmarks.len(), landmark);
     let mut out = Vec::new();
-    for (x, &(i1, j1)) in seeds.iter().enumerate() {
-        for &(i2, j2) in &seeds[x + 1..] {
-            if i1 == i2 || j1 == j2 {
-                continue;
-            }
-            let (dp, p1_extent, p2_extent) = between_detections.between(i1, i2);
-            let (dq, q1_extent, q2_extent) = between_landmarks.between(j1, j2);
-            let tolerance = p1_extent + p2_extent + q1_extent + q2_extent + 2.0 * SLACK_M;
-            // Short baselines give a poorly determined rotation.
-            if (dp - dq).abs() > tolerance || dp < tolerance {
-                continue;
-            }
-            let motion = Motion::from_pairs(
-                [detection(i1).point, detection(i2).point],
-                [landmark(j1).point, landmark(j2).point],
-            );
-            let most = within_reach(candidates, &motion);
-            out.push(Hypothesis {
-                motion,
-                most,
-                fit: None,
-            });
+    for (x, y) in pairs {
+        let ((i1, j1), (i2, j2)) = (seeds[x], seeds[y]);
+        if i1 == i2 || j1 == j2 {
+            continue;
         }
+        let (dp, p1_extent, p2_extent) = between_detections.between(i1, i2);
+        let (dq, q1_extent, q2_extent) = between_landmarks.between(j1, j2);
+        let tolerance = p1_extent + p2_extent + q1_extent + q2_extent + 2.0 * SLACK_M;
+        // Short baselines give a poorly determined rotation.
+        if (dp - dq).abs() > tolerance || dp < tolerance {
+            continue;
+        }
+        let motion = Motion::from_pairs(
+            [detection(i1).point, detection(i2).point],
+            [landmark(j1).point, landmark(j2).point],
+        );
+        let most = within_reach(candidates, &motion);
+        out.push(Hypothesis {
+            motion,
+            seeds: (x, y),
+            most,
+            fit: None,
+        });
     }
     out
+}
+
+/// Every two of `count` seeds, each once, the first below the second, in order.
+fn seed_pairs(count: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..count).flat_map(move |x| (x + 1..count).map(move |y| (x, y)))
 }
 
 /// The distance between every two of some placements, and how far each reaches along the line
@@ -258,24 +308,45 @@ impl Baselines {
     }
 }
 
-/// The inliers of the best-scoring hypothesis, if it explains at least [`MIN_INLIERS`] and
-/// scores [`MARGIN`] more than any hypothesis with a different assignment.
+/// The inliers of the best-scoring hypothesis of those `tried` (indices into `hypotheses`), if
+/// it explains at least [`MIN_INLIERS`] and scores [`MARGIN`] more than any hypothesis with a
+/// different assignment.
 ///
 /// Hypotheses are scored from the highest bound down ([`Hypothesis::most`]), and no further
 /// once no bound left comes within the margin of the best score so far: such a hypothesis can
 /// neither be the best nor stop it winning, whatever its assignment, so the answer is the one
-/// scoring every hypothesis gives (marsyard seed 7: about a fifth of them are scored).
-fn decisive(hypotheses: &mut [Hypothesis], candidates: &Candidates) -> Option<Vec<(usize, usize)>> {
-    let mut order: Vec<usize> = (0..hypotheses.len()).collect();
+/// scoring every hypothesis gives (marsyard seed 7: about a fifth of them are scored). Nor once
+/// the bounds left fall below [`MIN_INLIERS`] while the best so far cannot win: the best of all
+/// is then either that one or a hypothesis with too few inliers, and neither registers (most
+/// frames of a run lie out of a navigator's sight, and there nothing wins).
+fn decisive(
+    hypotheses: &mut [Hypothesis],
+    tried: &[usize],
+    candidates: &Candidates,
+) -> Option<Vec<(usize, usize)>> {
+    let mut order = tried.to_vec();
     order.sort_by_key(|&k| std::cmp::Reverse(hypotheses[k].most));
     let mut top = f64::NEG_INFINITY;
+    let mut too_few_judged = false;
     for k in order {
         if hypotheses[k].most as f64 + MARGIN <= top {
             break;
         }
+        // At the first bound below the fewest inliers: unless the best so far can win, the
+        // answer is none.
+        if hypotheses[k].most < MIN_INLIERS && !too_few_judged {
+            winner(hypotheses, tried)?;
+            too_few_judged = true;
+        }
         top = top.max(hypotheses[k].scored(candidates).score);
     }
-    let scored = || hypotheses.iter().filter_map(|h| h.fit.as_ref());
+    winner(hypotheses, tried)
+}
+
+/// The inliers of the best-scoring of the scored hypotheses among those `tried`, if it has at
+/// least [`MIN_INLIERS`] and scores [`MARGIN`] more than any with a different assignment.
+fn winner(hypotheses: &[Hypothesis], tried: &[usize]) -> Option<Vec<(usize, usize)>> {
+    let scored = || tried.iter().filter_map(|&k| hypotheses[k].fit.as_ref());
     let best = scored().max_by(|a, b| a.score.total_cmp(&b.score))?;
     let runner_up = scored()
         .filter(|h| !same_assignment(&h.inliers, &best.inliers))
@@ -285,11 +356,12 @@ fn decisive(hypotheses: &mut [Hypothesis], candidates: &Candidates) -> Option<Ve
         .then(|| best.inliers.clone())
 }
 
-/// The null model of [`super::significance`] for this registration: the seed pairs tried, the
-/// density of the frame's landmarks (the greater of their mean density over their bounding box
-/// widened by [`CHANCE_MARGIN_M`] on each side, and the densest disc of radius
-/// [`CLUSTER_RADIUS_M`] around one of them), and the detections with a look-alike in the frame.
-fn chance(frame: &Frame, seeds: &[(usize, usize)], correspondences: &[(usize, usize)]) -> Chance {
+/// The null model of [`super::significance`] for this registration: the pairs of its `seeds`
+/// seed correspondences tried, the density of the frame's landmarks (the greater of their mean
+/// density over their bounding box widened by [`CHANCE_MARGIN_M`] on each side, and the densest
+/// disc of radius [`CLUSTER_RADIUS_M`] around one of them), and the detections with a
+/// look-alike in the frame.
+fn chance(frame: &Frame, seeds: usize, correspondences: &[(usize, usize)]) -> Chance {
     let (mut low, mut high) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for (_, q) in &frame.landmarks {
         for axis in 0..2 {
@@ -316,7 +388,7 @@ fn chance(frame: &Frame, seeds: &[(usize, usize)], correspondences: &[(usize, us
     detections.sort_unstable();
     detections.dedup();
     Chance {
-        tests: (seeds.len() * seeds.len().saturating_sub(1) / 2).max(1) as f64,
+        tests: (seeds * seeds.saturating_sub(1) / 2).max(1) as f64,
         density: mean.max(densest),
         detections: detections.len(),
     }
@@ -333,16 +405,21 @@ fn significant(
     current: &[Option<Placed>],
     frame: &Frame,
     hypotheses: &mut [Hypothesis],
+    tried: &[usize],
     candidates: &Candidates,
     chance: &Chance,
 ) -> Option<Vec<(usize, usize)>> {
     // A hypothesis bounded below the fewest inliers cannot have them: it is left unscored.
-    let judged: Vec<(f64, Vec<(usize, usize)>)> = hypotheses
-        .iter_mut()
-        .filter(|h| h.most >= MIN_INLIERS)
-        .map(|h| h.scored(candidates))
-        .filter(|h| h.inliers.len() >= MIN_INLIERS)
-        .map(|h| core(current, frame, &h.inliers, chance))
+    let judged: Vec<(f64, Vec<(usize, usize)>)> = tried
+        .iter()
+        .filter_map(|&k| {
+            let hypothesis = &mut hypotheses[k];
+            if hypothesis.most < MIN_INLIERS {
+                return None;
+            }
+            let fit = hypothesis.scored(candidates);
+            (fit.inliers.len() >= MIN_INLIERS).then(|| core(current, frame, &fit.inliers, chance))
+        })
         .collect();
     let (nfa, inliers) = judged.iter().min_by(|a, b| a.0.total_cmp(&b.0))?;
     let rivals_by_chance = judged
@@ -1077,6 +1154,62 @@ pub(super) mod tests {
         }
     }
 
+    /// A field of 16 rocks, every other one a grid of rocks 3 m apart (a motion one step off
+    /// pairs nearly as many, and the margin decides), and a station that sees the first
+    /// `shared` of them (returned), each a random distance off, from 3 m away at a random
+    /// turn, and ten other rocks.
+    fn trial_scene(
+        next: &mut impl FnMut() -> f64,
+        trial: usize,
+    ) -> (Frame, Vec<Option<Placed>>, usize) {
+        let rocks: Vec<[f64; 2]> = (0..16)
+            .map(|k| match trial % 2 {
+                0 => [20.0 * (next() - 0.5), 20.0 * (next() - 0.5)],
+                _ => [
+                    3.0 * (k % 4) as f64 + 0.05 * next(),
+                    3.0 * (k / 4) as f64 + 0.05 * next(),
+                ],
+            })
+            .collect();
+        let frame = Frame {
+            accumulated: false,
+            departed: Vec::new(),
+            unmapped: Vec::new(),
+            landmarks: rocks
+                .iter()
+                .enumerate()
+                .map(|(k, &p)| {
+                    (
+                        k as LandmarkId,
+                        Placed::along(p, 6.3 * next(), 0.2 + next(), 0.1),
+                    )
+                })
+                .collect(),
+        };
+        let (shared, error, angle) = (2 + trial % 8, next() * next(), 6.3 * next());
+        let (sin, cos) = angle.sin_cos();
+        let mut current: Vec<Option<Placed>> = Vec::new();
+        let others = std::iter::repeat_n(None, 10);
+        for seen in rocks[..shared].iter().map(Some).chain(others) {
+            let [x, y] = match seen {
+                Some(p) => [
+                    p[0] - 3.0 + error * (next() - 0.5),
+                    p[1] + error * (next() - 0.5),
+                ],
+                None => [20.0 * (next() - 0.5), 20.0 * (next() - 0.5)],
+            };
+            let point = [cos * x + sin * y, -sin * x + cos * y];
+            current.push(Some(Placed::along(point, 6.3 * next(), 0.2 + next(), 0.1)));
+        }
+        (frame, current, shared)
+    }
+
+    /// Whether landmark `l` looks like detection `i` in [`trial_scene`]: its own rock's, and
+    /// one in four others.
+    fn trial_alike(shared: usize) -> impl Fn(usize, LandmarkId) -> bool {
+        move |i, l| i % shared == l as usize || (i + 3 * l as usize) % 4 == 0
+    }
+
     /// [`decisive`], scoring only the hypotheses whose bound comes within the margin of the best
     /// score, decides as scoring every one does: on fields scattered and on grids, sharing a
     /// few to most rocks with the frame, placed a little to far off, among look-alikes (a
@@ -1088,55 +1221,14 @@ pub(super) mod tests {
         let mut next = uniform(11);
         let (mut decided, mut undecided, mut unscored) = (0, 0, 0);
         for trial in 0..300 {
-            // Every other field a grid of rocks 3 m apart: a motion one step off pairs nearly
-            // as many, and the margin decides.
-            let rocks: Vec<[f64; 2]> = (0..16)
-                .map(|k| match trial % 2 {
-                    0 => [20.0 * (next() - 0.5), 20.0 * (next() - 0.5)],
-                    _ => [
-                        3.0 * (k % 4) as f64 + 0.05 * next(),
-                        3.0 * (k / 4) as f64 + 0.05 * next(),
-                    ],
-                })
-                .collect();
-            let frame = Frame {
-                accumulated: false,
-                departed: Vec::new(),
-                unmapped: Vec::new(),
-                landmarks: rocks
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &p)| {
-                        (
-                            k as LandmarkId,
-                            Placed::along(p, 6.3 * next(), 0.2 + next(), 0.1),
-                        )
-                    })
-                    .collect(),
-            };
-            // The station sees the first `shared` rocks, each `error` metres off, from 3 m
-            // away turned by `angle`, and ten other rocks.
-            let (shared, error, angle) = (2 + trial % 8, next() * next(), 6.3 * next());
-            let (sin, cos) = angle.sin_cos();
-            let mut current: Vec<Option<Placed>> = Vec::new();
-            let others = std::iter::repeat_n(None, 10);
-            for seen in rocks[..shared].iter().map(Some).chain(others) {
-                let [x, y] = match seen {
-                    Some(p) => [
-                        p[0] - 3.0 + error * (next() - 0.5),
-                        p[1] + error * (next() - 0.5),
-                    ],
-                    None => [20.0 * (next() - 0.5), 20.0 * (next() - 0.5)],
-                };
-                let point = [cos * x + sin * y, -sin * x + cos * y];
-                current.push(Some(Placed::along(point, 6.3 * next(), 0.2 + next(), 0.1)));
-            }
+            let (frame, current, shared) = trial_scene(&mut next, trial);
+            let alike = trial_alike(shared);
             let all: Vec<(usize, usize)> = (0..current.len())
                 .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
-                .filter(|&(i, j)| i % shared == j || (i + 3 * j) % 4 == 0)
+                .filter(|&(i, j)| alike(i, j as LandmarkId))
                 .collect();
             let candidates = Candidates::new(&current, &frame, &all);
-            let mut every = hypotheses(&current, &frame, &all, &candidates);
+            let mut every = hypotheses(&current, &frame, &all, seed_pairs(all.len()), &candidates);
             let fits: Vec<&Fit> = every.iter_mut().map(|h| h.scored(&candidates)).collect();
             let best = fits.iter().max_by(|a, b| a.score.total_cmp(&b.score));
             let expected = best.and_then(|best| {
@@ -1152,9 +1244,11 @@ pub(super) mod tests {
                 let fit = h.fit.as_ref().expect("scored");
                 assert!(fit.inliers.len() <= h.most && fit.score <= h.most as f64);
             }
-            let mut bounded = hypotheses(&current, &frame, &all, &candidates);
+            let mut bounded =
+                hypotheses(&current, &frame, &all, seed_pairs(all.len()), &candidates);
+            let tried: Vec<usize> = (0..bounded.len()).collect();
             assert_eq!(
-                decisive(&mut bounded, &candidates),
+                decisive(&mut bounded, &tried, &candidates),
                 expected,
                 "trial {trial}"
             );
@@ -1167,6 +1261,44 @@ pub(super) mod tests {
             "{decided} decided, {undecided} not"
         );
         assert!(unscored > 1000, "{unscored} hypotheses left unscored");
+    }
+
+    /// Seed sets tried in turn, the hypotheses they share scored once, register as each set
+    /// tried alone in turn does: a narrow set then a wider one holding it (as `associate`
+    /// tries them), and two sets that only partly overlap.
+    #[test]
+    fn seed_sets_tried_together_register_as_each_tried_alone() {
+        let mut next = uniform(23);
+        let (mut by_first, mut by_second) = (0, 0);
+        for trial in 0..300 {
+            let (frame, current, shared) = trial_scene(&mut next, trial);
+            let alike = trial_alike(shared);
+            // In one scattered field in two the narrow set holds no true pair, and registers
+            // nothing or by chance; `other` overlaps it only in part.
+            let narrow = |i: usize, l: LandmarkId| {
+                alike(i, l) && (trial % 4 != 0 || (i + l as usize) % 2 == 1)
+            };
+            let other = |i: usize, l: LandmarkId| alike(i, l) && (i + l as usize) % 3 != 1;
+            let sets: [[&dyn Fn(usize, LandmarkId) -> bool; 2]; 2] =
+                [[&narrow, &alike], [&narrow, &other]];
+            for sets in sets {
+                let first = register(&current, &frame, &alike, &sets[..1]);
+                let alone = first
+                    .clone()
+                    .or_else(|| register(&current, &frame, &alike, &sets[1..]));
+                assert_eq!(
+                    register(&current, &frame, &alike, &sets),
+                    alone,
+                    "trial {trial}"
+                );
+                by_first += first.is_some() as usize;
+                by_second += (first.is_none() && alone.is_some()) as usize;
+            }
+        }
+        assert!(
+            by_first > 50 && by_second > 30,
+            "{by_first} registered by the first set, {by_second} by the second"
+        );
     }
 
     /// The table-driven [`matches`] keeps exactly the pairs, in the order, that testing every
@@ -1285,7 +1417,7 @@ pub(super) mod tests {
             })
             .collect();
         let registration =
-            register(&current, &frame, &|_, _| true, &|_, _| true).expect("registers");
+            register(&current, &frame, &|_, _| true, &[&|_, _| true]).expect("registers");
         let mut pairs = registration.pairs.clone();
         pairs.sort_unstable();
         let expected: Vec<(usize, LandmarkId)> = order
@@ -1317,7 +1449,7 @@ pub(super) mod tests {
         let mut current: Vec<Option<Placed>> = FIELD.iter().map(|&p| Some(place(p, 0.2))).collect();
         current.push(Some(place([13.5, -13.0], 5.0)));
         let registration =
-            register(&current, &frame, &|_, _| true, &|_, _| true).expect("registers");
+            register(&current, &frame, &|_, _| true, &[&|_, _| true]).expect("registers");
         let mut pairs = registration.pairs.clone();
         pairs.sort_unstable();
         let expected: Vec<(usize, LandmarkId)> =
@@ -1409,12 +1541,10 @@ pub(super) mod tests {
             .flat_map(|i| (0..frame.landmarks.len()).map(move |j| (i, j)))
             .collect();
         let candidates = Candidates::new(&current, &frame, &all);
-        assert!(decisive(
-            &mut hypotheses(&current, &frame, &all, &candidates),
-            &candidates
-        )
-        .is_none());
-        let registration = register(&current, &frame, &alike, &alike).expect("registers");
+        let mut every = hypotheses(&current, &frame, &all, seed_pairs(all.len()), &candidates);
+        let tried: Vec<usize> = (0..every.len()).collect();
+        assert!(decisive(&mut every, &tried, &candidates).is_none());
+        let registration = register(&current, &frame, &alike, &[&alike]).expect("registers");
         let mut pairs = registration.pairs;
         pairs.sort_unstable();
         assert_eq!(pairs, [(0, 0), (1, 1), (2, 2), (3, 3)]);
@@ -1430,12 +1560,14 @@ pub(super) mod tests {
             .collect();
         let truth = [(0, 0), (1, 1), (2, 2), (3, 3)];
         let candidates = Candidates::new(&current, &frame, &all);
-        assert!(hypotheses(&current, &frame, &all, &candidates)
-            .iter_mut()
-            .map(|h| h.scored(&candidates))
-            .any(|h| h.inliers.len() >= MIN_INLIERS && same_assignment(&h.inliers, &truth)));
+        assert!(
+            hypotheses(&current, &frame, &all, seed_pairs(all.len()), &candidates)
+                .iter_mut()
+                .map(|h| h.scored(&candidates))
+                .any(|h| h.inliers.len() >= MIN_INLIERS && same_assignment(&h.inliers, &truth))
+        );
         let alike = |_: usize, _: LandmarkId| true;
-        assert_eq!(register(&current, &frame, &alike, &alike), None);
+        assert_eq!(register(&current, &frame, &alike, &[&alike]), None);
     }
 
     #[test]
@@ -1447,6 +1579,9 @@ pub(super) mod tests {
             landmarks: vec![(1, Placed::disc([1.0, 1.0], 0.1))],
         };
         let current = vec![Some(Placed::disc([1.0, 1.0], 0.1))];
-        assert_eq!(register(&current, &frame, &|_, _| true, &|_, _| true), None);
+        assert_eq!(
+            register(&current, &frame, &|_, _| true, &[&|_, _| true]),
+            None
+        );
     }
 }
