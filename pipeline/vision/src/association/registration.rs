@@ -185,9 +185,13 @@ struct Hypothesis {
     motion: Motion,
     /// The two seed correspondences it was hypothesised from, by index into the seeds.
     seeds: (usize, usize),
-    /// How many detections the motion brings within reach of a look-alike ([`within_reach`]):
-    /// no more can be its inliers, so its score is no higher.
+    /// How many detections the motion brings within reach of a look-alike ([`bounds`]):
+    /// no more can be its inliers.
     most: usize,
+    /// Its score is no higher: each of those detections' best fit as far as the reaches of
+    /// its placement and its look-alikes' allow ([`bounds`]), summed. (Counting each as 1,
+    /// as `most`, left three in four hypotheses to score where the rover saw many rocks.)
+    best: f64,
     fit: Option<Fit>,
 }
 
@@ -241,11 +245,12 @@ fn hypotheses(
             [detection(i1).point, detection(i2).point],
             [landmark(j1).point, landmark(j2).point],
         );
-        let most = within_reach(candidates, &motion);
+        let (most, best) = bounds(candidates, &motion);
         out.push(Hypothesis {
             motion,
             seeds: (x, y),
             most,
+            best,
             fit: None,
         });
     }
@@ -312,32 +317,36 @@ impl Baselines {
 /// it explains at least [`MIN_INLIERS`] and scores [`MARGIN`] more than any hypothesis with a
 /// different assignment.
 ///
-/// Hypotheses are scored from the highest bound down ([`Hypothesis::most`]), and no further
+/// Hypotheses are scored from the highest bound down ([`Hypothesis::best`]), and no further
 /// once no bound left comes within the margin of the best score so far: such a hypothesis can
 /// neither be the best nor stop it winning, whatever its assignment, so the answer is the one
 /// scoring every hypothesis gives (marsyard seed 7: about a fifth of them are scored). Nor once
-/// the bounds left fall below [`MIN_INLIERS`] while the best so far cannot win: the best of all
-/// is then either that one or a hypothesis with too few inliers, and neither registers (most
-/// frames of a run lie out of a navigator's sight, and there nothing wins).
+/// every hypothesis that may have [`MIN_INLIERS`] is scored while the best so far cannot win:
+/// the best of all is then either that one or a hypothesis with too few inliers, and neither
+/// registers (frames out of a navigator's sight, where nothing wins).
 fn decisive(
     hypotheses: &mut [Hypothesis],
     tried: &[usize],
     candidates: &Candidates,
 ) -> Option<Vec<(usize, usize)>> {
     let mut order = tried.to_vec();
-    order.sort_by_key(|&k| std::cmp::Reverse(hypotheses[k].most));
+    order.sort_by(|&a, &b| hypotheses[b].best.total_cmp(&hypotheses[a].best));
+    let may_have_enough = |h: &Hypothesis| h.most >= MIN_INLIERS && h.fit.is_none();
+    let mut unjudged = tried
+        .iter()
+        .filter(|&&k| may_have_enough(&hypotheses[k]))
+        .count();
+    let mut judged_enough = false;
     let mut top = f64::NEG_INFINITY;
-    let mut too_few_judged = false;
     for k in order {
-        if hypotheses[k].most as f64 + MARGIN <= top {
+        if unjudged == 0 && !judged_enough {
+            winner(hypotheses, tried)?;
+            judged_enough = true;
+        }
+        if hypotheses[k].best + MARGIN <= top {
             break;
         }
-        // At the first bound below the fewest inliers: unless the best so far can win, the
-        // answer is none.
-        if hypotheses[k].most < MIN_INLIERS && !too_few_judged {
-            winner(hypotheses, tried)?;
-            too_few_judged = true;
-        }
+        unjudged -= usize::from(may_have_enough(&hypotheses[k]));
         top = top.max(hypotheses[k].scored(candidates).score);
     }
     winner(hypotheses, tried)
@@ -905,12 +914,22 @@ impl Motion {
 struct Candidates {
     /// Detections with a placement and a look-alike in the frame.
     detections: Vec<Candidate>,
-    /// Each detection's look-alike landmarks in turn: the landmark's index into the frame's
-    /// landmarks, its coordinates and its grown placement's reach, side by side so that the
-    /// distance test runs over them without looking up the others.
-    alike: Vec<(usize, [f64; 2], f64)>,
+    /// Each detection's look-alike landmarks in turn, side by side so that the distance test
+    /// runs over them without looking up the others.
+    alike: Vec<LookAlike>,
     /// The frame's landmarks' placements grown by half the slack.
     grown: Vec<Matrix2<f64>>,
+}
+
+/// A look-alike landmark of a detection in [`Candidates`].
+struct LookAlike {
+    /// Its index into the frame's landmarks, its point and its grown placement's reach.
+    landmark: usize,
+    point: [f64; 2],
+    reach: f64,
+    /// How fast the bound on the pair's fit falls with the square of the distance between
+    /// their points ([`fit_bound`]).
+    fit_slope: f64,
 }
 
 /// One placed detection of [`Candidates`].
@@ -952,15 +971,25 @@ impl Candidates {
                 });
             }
             let q = frame.landmarks[j].1;
-            alike.push((j, q.point, q.reach() + half));
-            detections.last_mut().expect("pushed above").alike.end = alike.len();
+            let detection = detections.last_mut().expect("pushed above");
+            let reach = q.reach() + half;
+            alike.push(LookAlike {
+                landmark: j,
+                point: q.point,
+                reach,
+                fit_slope: fit_slope(
+                    (detection.reach, detection.grown.trace()),
+                    (reach, q.grown(half).trace()),
+                ),
+            });
+            detection.alike.end = alike.len();
         }
         for detection in &mut detections {
             // Wider than the reach by far more than rounding, so that the grid never leaves
             // out a pair that [`in_reach`] takes.
             let reaches: Vec<([f64; 2], f64)> = alike[detection.alike.clone()]
                 .iter()
-                .map(|&(_, point, reach)| (point, (detection.reach + reach) * (1.0 + 1e-6)))
+                .map(|a| (a.point, (detection.reach + a.reach) * (1.0 + 1e-6)))
                 .collect();
             detection.reaches = DiscGrid::new(&reaches);
         }
@@ -977,7 +1006,7 @@ impl Candidates {
         &'c self,
         candidate: &'c Candidate,
         moved: [f64; 2],
-    ) -> impl Iterator<Item = &'c (usize, [f64; 2], f64)> {
+    ) -> impl Iterator<Item = &'c LookAlike> {
         let listed = &self.alike[candidate.alike.clone()];
         candidate
             .reaches
@@ -987,30 +1016,57 @@ impl Candidates {
     }
 }
 
-/// Whether a detection moved to `moved`, its grown placement reaching `reach`, lies within
-/// reach of a landmark at `point` reaching `landmark_reach`: beyond both placements' reach the
+/// The squared distance from a detection moved to `moved`, its grown placement reaching
+/// `reach`, to a look-alike, if it lies within reach of it: beyond both placements' reach the
 /// pair is off whatever their shapes; most pairs are, and the test needs no ellipse.
-fn in_reach(moved: [f64; 2], reach: f64, point: [f64; 2], landmark_reach: f64) -> bool {
-    let (dx, dy) = (moved[0] - point[0], moved[1] - point[1]);
-    let bound = reach + landmark_reach;
-    dx * dx + dy * dy <= bound * bound * (1.0 + 1e-9)
+fn in_reach(moved: [f64; 2], reach: f64, alike: &LookAlike) -> Option<f64> {
+    let (dx, dy) = (moved[0] - alike.point[0], moved[1] - alike.point[1]);
+    let bound = reach + alike.reach;
+    let squared = dx * dx + dy * dy;
+    (squared <= bound * bound * (1.0 + 1e-9)).then_some(squared)
 }
 
 /// How many detections `motion` brings within reach of one of their look-alikes: a bound on
-/// how many it can pair one to one ([`matches`] tests the same pairs), and so on its score.
-fn within_reach(candidates: &Candidates, motion: &Motion) -> usize {
-    candidates
-        .detections
-        .iter()
-        .filter(|candidate| {
-            let moved = motion.apply(candidate.point);
-            candidates
-                .near(candidate, moved)
-                .any(|&(_, point, landmark_reach)| {
-                    in_reach(moved, candidate.reach, point, landmark_reach)
-                })
-        })
-        .count()
+/// how many it can pair one to one ([`matches`] tests the same pairs), and so on its inliers;
+/// and the sum of each one's best fit bound over the look-alikes it reaches ([`fit_slope`]), a
+/// bound on its score (one pair per detection, each fitting no better than its bound).
+fn bounds(candidates: &Candidates, motion: &Motion) -> (usize, f64) {
+    let (mut most, mut best) = (0, 0.0);
+    for candidate in &candidates.detections {
+        let moved = motion.apply(candidate.point);
+        let mut fits: Option<f64> = None;
+        for alike in candidates.near(candidate, moved) {
+            if let Some(squared) = in_reach(moved, candidate.reach, alike) {
+                let bound = 1.0 - squared * alike.fit_slope;
+                fits = Some(fits.map_or(bound, |f| f.max(bound)));
+            }
+        }
+        if let Some(fit) = fits {
+            most += 1;
+            best += fit.max(0.0);
+        }
+    }
+    (most, best)
+}
+
+/// How fast a bound on the fit ([`Separation::fit`]) of two grown placements falls with the
+/// squared distance between their points: the fit is at most `1 − slope · distance²`. From
+/// each one's reach (its longest semi-axis) and trace: [`bound_of_sum`] weighs them `1 + 1/t`
+/// and `1 + t`, `t` the square root of the ratio of the traces, so its ellipse's longest
+/// semi-axis squared is at most the same weighing of the reaches squared (Weyl), and the
+/// offset measured against that ellipse is at least the distance over that semi-axis.
+/// (Turning a placement changes neither its reach nor its trace.)
+fn fit_slope((reach_p, trace_p): (f64, f64), (reach_q, trace_q): (f64, f64)) -> f64 {
+    let widest = if trace_p <= 0.0 {
+        reach_q * reach_q
+    } else if trace_q <= 0.0 {
+        reach_p * reach_p
+    } else {
+        let t = (trace_p / trace_q).sqrt();
+        (1.0 + 1.0 / t) * reach_p * reach_p + (1.0 + t) * reach_q * reach_q
+    };
+    // A little gentle, so that rounding never puts a fit above its bound.
+    1.0 / (widest * (1.0 + 1e-6))
 }
 
 /// The one-to-one correspondences (nearest first, by [`Separation`] distance) that `motion`
@@ -1021,10 +1077,11 @@ fn matches(candidates: &Candidates, motion: &Motion) -> (Vec<(usize, usize)>, f6
         let (i, grown, reach) = (candidate.detection, &candidate.grown, candidate.reach);
         let moved = motion.apply(candidate.point);
         let mut turned = None;
-        for &(j, point, landmark_reach) in candidates.near(candidate, moved) {
-            if !in_reach(moved, reach, point, landmark_reach) {
+        for alike in candidates.near(candidate, moved) {
+            if in_reach(moved, reach, alike).is_none() {
                 continue;
             }
+            let (j, point) = (alike.landmark, alike.point);
             let turned =
                 *turned.get_or_insert_with(|| turned_shape(grown, [motion.cos, motion.sin]));
             let separation = separation_of(
@@ -1242,7 +1299,7 @@ pub(super) mod tests {
             });
             for h in &every {
                 let fit = h.fit.as_ref().expect("scored");
-                assert!(fit.inliers.len() <= h.most && fit.score <= h.most as f64);
+                assert!(fit.inliers.len() <= h.most && fit.score <= h.best);
             }
             let mut bounded =
                 hypotheses(&current, &frame, &all, seed_pairs(all.len()), &candidates);
