@@ -74,10 +74,10 @@ use qrm_core::measurement::StationView;
 use qrm_core::navigation::{cell_of, Cell, Command, LegFollower, Route, RouteCost, RouteGraph};
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::Detection;
-use qrm_vision::localization::{KnownMap, Whereabouts};
+use qrm_vision::localization::{KnownMap, Location, Whereabouts};
 use qrm_vision::ranging::{PrimaryEye, RangeInterval};
 use qrm_vision::run::front_end::detect_panoramas;
-use qrm_vision::run::RunSettings;
+use qrm_vision::run::{RunSettings, StationDetections};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -119,6 +119,12 @@ pub struct Driving {
     /// Steps before the trip is given up.
     pub max_steps: usize,
     pub cost: RouteCost,
+    /// How many times each step's perception (detection, and association with the map) runs
+    /// to be timed, the fastest counting (`navigate drive --repeat`, as `navigate locate
+    /// --repeat`): the fastest run is the code's own time, the others add what else the
+    /// machine was doing. The runs are identical; the rover acts on the first. 1 but for
+    /// benchmarks.
+    pub perception_runs: usize,
 }
 
 /// How a trip ended, as the navigator saw it.
@@ -266,6 +272,55 @@ impl Terrain<'_> {
     }
 }
 
+/// A step's panorama as the navigator perceived it, and how long that took: the fastest of
+/// [`Driving::perception_runs`] runs, in all and of it the detection.
+struct Perceived {
+    detections: StationDetections,
+    location: Location,
+    seconds: f64,
+    detect_seconds: f64,
+}
+
+/// Detects the rocks in the stereo pair and locates them against the map, timed.
+fn perceive(
+    left: &RgbImage,
+    right: &RgbImage,
+    calib: &Calibration,
+    known: &KnownMap<Edc>,
+    settings: &RunSettings,
+    driving: &Driving,
+) -> Perceived {
+    let run = || {
+        let started = Instant::now();
+        let detections = detect_panoramas(
+            "rover",
+            left,
+            Some(right),
+            PrimaryEye::Left,
+            false,
+            calib,
+            &settings.detector,
+        );
+        let detect_seconds = started.elapsed().as_secs_f64();
+        let location = known.locate(&detections, calib, &settings.sensor, &settings.association);
+        Perceived {
+            detections,
+            location,
+            seconds: started.elapsed().as_secs_f64(),
+            detect_seconds,
+        }
+    };
+    let mut first = run();
+    for _ in 1..driving.perception_runs {
+        let again = run();
+        if again.seconds < first.seconds {
+            first.seconds = again.seconds;
+            first.detect_seconds = again.detect_seconds;
+        }
+    }
+    first
+}
+
 /// Drives from `start` to the cell of landmark `goal` (see the module documentation).
 pub fn drive(
     terrain: &Terrain,
@@ -311,23 +366,13 @@ pub fn drive(
     let mut avoidance = HazardAvoidance::default();
     for index in 0..driving.max_steps {
         let (left, right) = terrain.panoramas(pose);
+        let Perceived {
+            detections,
+            location,
+            seconds: perceive_seconds,
+            detect_seconds,
+        } = perceive(&left, &right, terrain.calib, known, settings, driving);
         let started = Instant::now();
-        let detections = detect_panoramas(
-            "rover",
-            &left,
-            Some(&right),
-            PrimaryEye::Left,
-            false,
-            terrain.calib,
-            &settings.detector,
-        );
-        let detect_seconds = started.elapsed().as_secs_f64();
-        let location = known.locate(
-            &detections,
-            terrain.calib,
-            &settings.sensor,
-            &settings.association,
-        );
         let (visible, view) = &location.seen;
         for seen in last_seen.values_mut() {
             seen.ago += 1;
@@ -353,7 +398,7 @@ pub fn drive(
         };
         // Ends the step's navigator time and logs the step with its decision.
         let log = |trip: &mut Trip, command, target, bearing: Option<f64>| {
-            let seconds = started.elapsed().as_secs_f64();
+            let seconds = perceive_seconds + started.elapsed().as_secs_f64();
             trip.navigator_seconds.push(seconds);
             trip.steps.push(StepLog {
                 step: index,
