@@ -406,7 +406,10 @@ fn drives_through_the_rendered_world_without_seeing_it() {
     assert!(csv.lines().nth(1).unwrap().starts_with("1,"), "{csv}");
     // `--repeat` times the steps' perception as the fastest of several runs; the rover acts
     // as before.
-    let o = two_trips(&dir.join("repeat"), &["--only", "1", "--repeat", "2"]);
+    let o = two_trips(
+        &dir.join("repeat"),
+        &["--only", "1", "--repeat", "2", "--again-over", "0"],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let read = |file: &str| -> serde_json::Value {
         serde_json::from_str(&std::fs::read_to_string(dir.join("repeat").join(file)).unwrap())
@@ -415,9 +418,12 @@ fn drives_through_the_rendered_world_without_seeing_it() {
     assert_eq!(read("trips.json")[0]["path"], honest[1].0);
     let timing = &read("summary.json")["navigator_seconds_per_step"];
     assert_eq!(timing["fastest_of_runs"], 2);
+    assert_eq!(timing["trips_driven_again"], 1);
     assert!(timing["p99"].as_f64().unwrap() <= timing["max"].as_f64().unwrap());
-    let o = two_trips(&dir.join("repeat0"), &["--repeat", "0"]);
-    assert_eq!(o.status.code(), Some(2));
+    for bad in [["--repeat", "0"], ["--again-over", "inf"]] {
+        let o = two_trips(&dir.join("bad"), &bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+    }
     let o = only("2", "beyond");
     assert_eq!(o.status.code(), Some(2));
     assert!(

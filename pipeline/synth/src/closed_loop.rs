@@ -177,6 +177,41 @@ pub struct Trip {
     pub steps: Vec<StepLog>,
 }
 
+impl Trip {
+    /// Takes each step's time from `again`, the same trip driven once more, where it was
+    /// faster (`navigate drive --again-over`). False, and nothing taken, if `again` took
+    /// other steps.
+    pub fn keep_faster_steps(&mut self, again: &Trip) -> bool {
+        let untimed = |s: &StepLog| StepLog {
+            navigator_seconds: 0.0,
+            detect_seconds: 0.0,
+            ..s.clone()
+        };
+        let same = self.steps.len() == again.steps.len()
+            && self
+                .steps
+                .iter()
+                .zip(&again.steps)
+                .all(|(a, b)| untimed(a) == untimed(b));
+        if !same {
+            return false;
+        }
+        for ((step, seconds), faster) in self
+            .steps
+            .iter_mut()
+            .zip(&mut self.navigator_seconds)
+            .zip(&again.steps)
+        {
+            if faster.navigator_seconds < step.navigator_seconds {
+                step.navigator_seconds = faster.navigator_seconds;
+                step.detect_seconds = faster.detect_seconds;
+                *seconds = faster.navigator_seconds;
+            }
+        }
+        true
+    }
+}
+
 /// One step of a trip: what the navigator identified and decided, and where the rover truly
 /// stood (the log's, never the navigator's).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -846,6 +881,59 @@ mod tests {
     use qrm_core::neighborhood::{RngEdge, RngEstimate};
     use qrm_vision::detection::{Appearance, Separation};
     use std::f64::consts::FRAC_PI_2;
+
+    /// A trip of one step along x for each of `seconds`, each taking that long.
+    fn timed_trip(seconds: &[f64]) -> Trip {
+        Trip {
+            number: 0,
+            start: [0.0, 0.0],
+            goal: 1,
+            outcome: Outcome::Arrived,
+            route: vec![1],
+            replans: 0,
+            path: (0..=seconds.len()).map(|k| [k as f64 * 0.5, 0.0]).collect(),
+            collisions: 0,
+            avoided: 0,
+            navigator_seconds: seconds.to_vec(),
+            in_goal_cell: true,
+            length_m: seconds.len() as f64 * 0.5,
+            straight_m: 1.0,
+            reference_m: None,
+            steps: seconds
+                .iter()
+                .enumerate()
+                .map(|(k, &s)| StepLog {
+                    step: k,
+                    position: [k as f64 * 0.5, 0.0],
+                    heading_deg: 0.0,
+                    identified: vec![1],
+                    detections: 1,
+                    cell: Some(1),
+                    command: "toward",
+                    target: Some(1),
+                    bearing_deg: Some(0.0),
+                    replans: 0,
+                    avoided: false,
+                    navigator_seconds: s,
+                    detect_seconds: s / 2.0,
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn a_trip_driven_again_keeps_each_steps_faster_time_only_for_the_same_steps() {
+        let mut trip = timed_trip(&[0.3, 0.1, 0.25]);
+        assert!(trip.keep_faster_steps(&timed_trip(&[0.2, 0.15, 0.05])));
+        assert_eq!(trip.navigator_seconds, [0.2, 0.1, 0.05]);
+        let detection: Vec<f64> = trip.steps.iter().map(|s| s.detect_seconds).collect();
+        assert_eq!(detection, [0.1, 0.05, 0.025]);
+        let mut elsewhere = timed_trip(&[0.01, 0.01, 0.01]);
+        elsewhere.steps[1].command = "lost";
+        assert!(!trip.keep_faster_steps(&elsewhere));
+        assert!(!trip.keep_faster_steps(&timed_trip(&[0.01, 0.01])));
+        assert_eq!(trip.navigator_seconds, [0.2, 0.1, 0.05]);
+    }
 
     fn rock(columns: [u32; 2], rows: [u32; 2]) -> Detection {
         Detection {
