@@ -229,14 +229,7 @@ pub fn run(args: &DriveArgs) -> Result<()> {
         let slow: Vec<usize> = (0..trips.len())
             .filter(|&t| trips[t].navigator_seconds.iter().any(|&s| s > limit))
             .collect();
-        let bar = ProgressBar::new(slow.len() as u64);
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} again     [{bar:40}] {pos}/{len} trips with a step over the limit ({elapsed}, eta {eta})",
-            )
-            .expect("static template")
-            .progress_chars("=> "),
-        );
+        let bar = super::simulate::progress(slow.len() as u64, "trips driven again");
         for t in slow {
             let (start, goal) = drawn[t];
             let again = drive(&terrain, known, graph, &settings, start, goal, &driving);

@@ -928,7 +928,7 @@ struct LookAlike {
     point: [f64; 2],
     reach: f64,
     /// How fast the bound on the pair's fit falls with the square of the distance between
-    /// their points ([`fit_bound`]).
+    /// their points ([`fit_slope`]).
     fit_slope: f64,
 }
 
@@ -956,6 +956,7 @@ impl Candidates {
         correspondences: &[(usize, usize)],
     ) -> Candidates {
         let half = 0.5 * SLACK_M;
+        let grown: Vec<Matrix2<f64>> = frame.landmarks.iter().map(|(_, q)| q.grown(half)).collect();
         let mut detections: Vec<Candidate> = Vec::new();
         let mut alike = Vec::new();
         for &(i, j) in correspondences {
@@ -979,7 +980,7 @@ impl Candidates {
                 reach,
                 fit_slope: fit_slope(
                     (detection.reach, detection.grown.trace()),
-                    (reach, q.grown(half).trace()),
+                    (reach, grown[j].trace()),
                 ),
             });
             detection.alike.end = alike.len();
@@ -996,7 +997,7 @@ impl Candidates {
         Candidates {
             detections,
             alike,
-            grown: frame.landmarks.iter().map(|(_, q)| q.grown(half)).collect(),
+            grown,
         }
     }
 
