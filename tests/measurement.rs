@@ -7,20 +7,33 @@ use qrm_core::calculus::{Calculus, RelationSet};
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
 use qrm_core::geometry::Point;
-use qrm_core::measurement::{Bearing, RangeOrder, StationView};
+use qrm_core::measurement::{Bearing, RangeBounds, RangeOrder, StationView};
 use qrm_tests::{random_point, rng};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 /// A camera, three landmarks, and what the camera observes of them: bearings perturbed inside
-/// `±delta` and a random subset of the true range order.
+/// `±delta`, a random subset of the true range order and, if `ranged`, range intervals holding
+/// the true ranges (some landmarks unranged).
 struct Scene {
     landmarks: [Point; 3],
     panorama: StationView,
 }
 
-fn random_scene(rng: &mut ChaCha8Rng, delta: f64) -> Scene {
+/// An interval around `range`, reaching a random fraction below and above it (as little as
+/// 1 % each way), or none at all one time in four.
+fn random_range_bounds(rng: &mut ChaCha8Rng, range: f64) -> RangeBounds {
+    if rng.random_bool(0.25) {
+        return RangeBounds::UNBOUNDED;
+    }
+    RangeBounds {
+        low: range * rng.random_range(0.5..0.99),
+        high: range * rng.random_range(1.01..2.0),
+    }
+}
+
+fn random_scene(rng: &mut ChaCha8Rng, delta: f64, ranged: bool) -> Scene {
     let camera = random_point(rng);
     let landmarks: [Point; 3] = std::array::from_fn(|_| {
         let scale = 10f64.powf(rng.random_range(-1.5..1.5));
@@ -52,9 +65,16 @@ fn random_scene(rng: &mut ChaCha8Rng, delta: f64) -> Scene {
         }
     }
     let order = RangeOrder::from_pairs(3, &pairs).expect("true order is acyclic");
+    let mut panorama = StationView::new(bearings, order).expect("valid panorama");
+    if ranged {
+        let bounds = range.map(|r| random_range_bounds(rng, r)).to_vec();
+        panorama = panorama
+            .with_ranges(bounds)
+            .expect("true ranges hold the true order");
+    }
     Scene {
         landmarks,
-        panorama: StationView::new(bearings, order).expect("valid panorama"),
+        panorama,
     }
 }
 
@@ -66,8 +86,9 @@ fn true_relations<C: Calculus>(p: &[Point; 3]) -> Option<[u8; 3]> {
     ])
 }
 
-/// Runs `count` random scenes in parallel; returns the number of soundness violations.
-fn violations<C: Calculus>(count: usize, delta: f64, seed: u64) -> usize {
+/// Runs `count` random scenes in parallel (with range intervals if `ranged`); returns the
+/// number of soundness violations.
+fn violations<C: Calculus>(count: usize, delta: f64, ranged: bool, seed: u64) -> usize {
     (0..count)
         .into_par_iter()
         .chunks(1000)
@@ -75,7 +96,7 @@ fn violations<C: Calculus>(count: usize, delta: f64, seed: u64) -> usize {
             let mut rng = rng(seed ^ (chunk[0] as u64).wrapping_mul(0x9e37_79b9));
             let mut bad = 0;
             for _ in chunk {
-                let scene = random_scene(&mut rng, delta);
+                let scene = random_scene(&mut rng, delta, ranged);
                 let Some(truth) = true_relations::<C>(&scene.landmarks) else {
                     continue;
                 };
@@ -99,28 +120,51 @@ fn violations<C: Calculus>(count: usize, delta: f64, seed: u64) -> usize {
 
 #[test]
 fn exact_bearings_never_exclude_the_true_region() {
-    assert_eq!(violations::<Edc>(700_000, 0.0, 1), 0);
+    assert_eq!(violations::<Edc>(700_000, 0.0, false, 1), 0);
 }
 
 #[test]
 fn uncertain_bearings_never_exclude_the_true_region() {
-    assert_eq!(violations::<Edc>(200_000, 0.005, 2), 0);
-    assert_eq!(violations::<Edc>(80_000, 0.05, 3), 0);
-    assert_eq!(violations::<Edc>(20_000, 0.3, 6), 0);
+    assert_eq!(violations::<Edc>(200_000, 0.005, false, 2), 0);
+    assert_eq!(violations::<Edc>(80_000, 0.05, false, 3), 0);
+    assert_eq!(violations::<Edc>(20_000, 0.3, false, 6), 0);
+}
+
+#[test]
+fn range_intervals_never_exclude_the_true_region() {
+    assert_eq!(violations::<Edc>(300_000, 0.0, true, 7), 0);
+    assert_eq!(violations::<Edc>(150_000, 0.005, true, 8), 0);
+    assert_eq!(violations::<Edc>(40_000, 0.05, true, 9), 0);
+}
+
+/// A range inside `bounds` (log-uniform), or anywhere over four decades when unbounded.
+fn sampled_range(rng: &mut ChaCha8Rng, bounds: RangeBounds) -> f64 {
+    if bounds.low > 0.0 && bounds.high.is_finite() {
+        bounds.low * (bounds.high / bounds.low).powf(rng.random_range(0.0..=1.0))
+    } else {
+        10f64.powf(rng.random_range(-2.0..2.0))
+    }
 }
 
 /// Everything that arrangements sampled from the observation reach (bearings inside their
-/// intervals, ranges in the order) must be in the measured set: a lower bound of the feasible
-/// set, drawn independently of the measurement code.
-fn sampled_lower_bound_is_contained(delta: f64, scenes: usize, samples: usize, seed: u64) {
+/// intervals, ranges in the order and in their intervals) must be in the measured set: a lower
+/// bound of the feasible set, drawn independently of the measurement code.
+fn sampled_lower_bound_is_contained(
+    delta: f64,
+    ranged: bool,
+    scenes: usize,
+    samples: usize,
+    seed: u64,
+) {
     let mut rng = rng(seed);
     for _ in 0..scenes {
-        let scene = random_scene(&mut rng, delta);
+        let scene = random_scene(&mut rng, delta, ranged);
         let panorama = &scene.panorama;
         let measured = panorama.measure_triple::<Edc>([0, 1, 2], [Edc::universe(); 3]);
         let mut reached = [RelationSet::EMPTY; 3];
         for _ in 0..samples {
-            let ranges: [f64; 3] = std::array::from_fn(|_| 10f64.powf(rng.random_range(-2.0..2.0)));
+            let ranges: [f64; 3] =
+                std::array::from_fn(|i| sampled_range(&mut rng, panorama.ranges[i]));
             let consistent = (0..3)
                 .all(|i| (0..3).all(|j| !panorama.order.is_nearer(i, j) || ranges[i] < ranges[j]));
             if !consistent {
@@ -155,21 +199,25 @@ fn sampled_lower_bound_is_contained(delta: f64, scenes: usize, samples: usize, s
 
 #[test]
 fn sampled_arrangements_stay_inside_the_measurement() {
-    sampled_lower_bound_is_contained(0.0, 400, 4000, 11);
-    sampled_lower_bound_is_contained(0.03, 100, 4000, 12);
+    sampled_lower_bound_is_contained(0.0, false, 400, 4000, 11);
+    sampled_lower_bound_is_contained(0.03, false, 100, 4000, 12);
+    sampled_lower_bound_is_contained(0.0, true, 300, 4000, 13);
+    sampled_lower_bound_is_contained(0.03, true, 100, 4000, 14);
 }
 
 #[test]
 fn fdc_measurement_is_sound() {
-    assert_eq!(violations::<Fdc>(100_000, 0.0, 4), 0);
-    assert_eq!(violations::<Fdc>(20_000, 0.05, 5), 0);
+    assert_eq!(violations::<Fdc>(100_000, 0.0, false, 4), 0);
+    assert_eq!(violations::<Fdc>(20_000, 0.05, false, 5), 0);
+    assert_eq!(violations::<Fdc>(20_000, 0.05, true, 10), 0);
 }
 
 /// The sweep against the branch-and-bound search, an independent decision procedure: every
 /// region the search keeps is in the sweep's result. The sweep may keep more: slivers thinner
 /// than the search's margin (10⁻⁷), which the sweep samples, and samples that fall on a
 /// boundary in rounding, which it classifies into both neighbours. Measured: 0 of 450 looser
-/// (23 before critical values from rounding noise were dropped).
+/// (23 before critical values from rounding noise were dropped). The second half adds range
+/// intervals around random true ranges, with part of the true order: 0 of 450 looser.
 #[test]
 fn sweep_agrees_with_branch_and_bound() {
     use qrm_core::feasibility::BranchAndBound;
@@ -177,23 +225,34 @@ fn sweep_agrees_with_branch_and_bound() {
     let engine = BranchAndBound::default();
     let mut rng = rng(21);
     let (mut relations, mut extra) = (0, 0);
-    for _ in 0..150 {
+    for scene in 0..300 {
         let bearings: [Bearing; 3] =
             std::array::from_fn(|_| Bearing::exact(rng.random_range(-3.2..3.2)));
-        let pairs: Vec<(usize, usize)> = [(0, 1), (1, 2), (0, 2)]
-            .into_iter()
-            .filter(|_| rng.random_bool(0.6))
-            .collect();
+        let (pairs, ranges) = if scene < 150 {
+            let pairs: Vec<(usize, usize)> = [(0, 1), (1, 2), (0, 2)]
+                .into_iter()
+                .filter(|_| rng.random_bool(0.6))
+                .collect();
+            (pairs, [RangeBounds::UNBOUNDED; 3])
+        } else {
+            let truth: [f64; 3] = std::array::from_fn(|_| 10f64.powf(rng.random_range(-1.0..1.0)));
+            let pairs: Vec<(usize, usize)> = (0..3)
+                .flat_map(|p| (0..3).map(move |q| (p, q)))
+                .filter(|&(p, q)| truth[p] < truth[q])
+                .filter(|_| rng.random_bool(0.6))
+                .collect();
+            (pairs, truth.map(|r| random_range_bounds(&mut rng, r)))
+        };
         let nearer = RangeOrder::from_pairs(3, &pairs)
             .unwrap()
             .restricted(&[0, 1, 2]);
-        let sweep = by_sweep(bearings, &nearer, [Edc::universe(); 3]);
-        let search = by_search(bearings, &nearer, [Edc::universe(); 3], &engine);
+        let sweep = by_sweep(bearings, &nearer, ranges, [Edc::universe(); 3]);
+        let search = by_search(bearings, &nearer, ranges, [Edc::universe(); 3], &engine);
         for k in 0..3 {
             relations += 1;
             assert!(
                 search[k].is_subset(sweep[k]),
-                "{bearings:?} {nearer:?}: search {} sweep {}",
+                "{bearings:?} {nearer:?} {ranges:?}: search {} sweep {}",
                 search[k],
                 sweep[k]
             );
@@ -331,58 +390,76 @@ fn narrow_cusp_near_a_is_not_skipped() {
 /// fraction. Before the interval method worked in range ratios (its box held two landmarks at
 /// one point at the corners of the range simplex, where every boundary function vanishes), 55 %
 /// of its states at δ = 0.001 rad lay beyond these, and at δ = 0.003 rad it kept 2.4 times the
-/// regions the branch-and-bound search does.
+/// regions the branch-and-bound search does. The same holds with range intervals (sampled
+/// inside them; the nominal sweep takes them too).
 #[test]
 fn uncertain_bearings_are_measured_tightly() {
     use qrm_core::measurement::by_sweep;
     let mut rng = rng(31);
-    for delta in [0.001, 0.003] {
-        let (mut measured_states, mut beyond) = (0, 0);
-        for _ in 0..150 {
-            let bearings: [Bearing; 3] = std::array::from_fn(|_| Bearing {
-                angle: rng.random_range(0.0..std::f64::consts::TAU),
-                uncertainty: delta,
-            });
-            let pairs: Vec<(usize, usize)> = [(0, 1), (1, 2), (0, 2)]
-                .into_iter()
-                .filter(|_| rng.random_bool(0.6))
-                .collect();
-            let order = RangeOrder::from_pairs(3, &pairs).unwrap();
-            let nearer = order.restricted(&[0, 1, 2]);
-            let view = StationView::new(bearings.to_vec(), order).unwrap();
-            let measured = view.measure_triple::<Edc>([0, 1, 2], [Edc::universe(); 3]);
-            let mut reached = by_sweep(
-                bearings.map(|b| Bearing::exact(b.angle)),
-                &nearer,
-                [Edc::universe(); 3],
-            );
-            for _ in 0..3000 {
-                let ranges: [f64; 3] =
-                    std::array::from_fn(|_| 10f64.powf(rng.random_range(-2.0..2.0)));
-                if nearer.iter().any(|&(p, q)| ranges[p] >= ranges[q]) {
-                    continue;
-                }
-                let p: [Point; 3] = std::array::from_fn(|i| {
-                    let angle = bearings[i].angle + rng.random_range(-delta..=delta);
-                    Point::new(ranges[i] * angle.cos(), ranges[i] * angle.sin())
+    for ranged in [false, true] {
+        for delta in [0.001, 0.003] {
+            let (mut measured_states, mut beyond) = (0, 0);
+            for _ in 0..150 {
+                let bearings: [Bearing; 3] = std::array::from_fn(|_| Bearing {
+                    angle: rng.random_range(0.0..std::f64::consts::TAU),
+                    uncertainty: delta,
                 });
-                if let Some(t) = true_relations::<Edc>(&p) {
-                    for k in 0..3 {
-                        reached[k] = reached[k].with(t[k]);
+                let (pairs, bounds) = if ranged {
+                    let truth: [f64; 3] =
+                        std::array::from_fn(|_| 10f64.powf(rng.random_range(-1.0..1.0)));
+                    let pairs: Vec<(usize, usize)> = (0..3)
+                        .flat_map(|p| (0..3).map(move |q| (p, q)))
+                        .filter(|&(p, q)| truth[p] < truth[q])
+                        .filter(|_| rng.random_bool(0.6))
+                        .collect();
+                    (pairs, truth.map(|r| random_range_bounds(&mut rng, r)))
+                } else {
+                    let pairs: Vec<(usize, usize)> = [(0, 1), (1, 2), (0, 2)]
+                        .into_iter()
+                        .filter(|_| rng.random_bool(0.6))
+                        .collect();
+                    (pairs, [RangeBounds::UNBOUNDED; 3])
+                };
+                let order = RangeOrder::from_pairs(3, &pairs).unwrap();
+                let nearer = order.restricted(&[0, 1, 2]);
+                let view = StationView::new(bearings.to_vec(), order)
+                    .and_then(|v| v.with_ranges(bounds.to_vec()))
+                    .unwrap();
+                let measured = view.measure_triple::<Edc>([0, 1, 2], [Edc::universe(); 3]);
+                let mut reached = by_sweep(
+                    bearings.map(|b| Bearing::exact(b.angle)),
+                    &nearer,
+                    bounds,
+                    [Edc::universe(); 3],
+                );
+                for _ in 0..3000 {
+                    let ranges: [f64; 3] =
+                        std::array::from_fn(|i| sampled_range(&mut rng, bounds[i]));
+                    if nearer.iter().any(|&(p, q)| ranges[p] >= ranges[q]) {
+                        continue;
+                    }
+                    let p: [Point; 3] = std::array::from_fn(|i| {
+                        let angle = bearings[i].angle + rng.random_range(-delta..=delta);
+                        Point::new(ranges[i] * angle.cos(), ranges[i] * angle.sin())
+                    });
+                    if let Some(t) = true_relations::<Edc>(&p) {
+                        for k in 0..3 {
+                            reached[k] = reached[k].with(t[k]);
+                        }
                     }
                 }
+                for k in 0..3 {
+                    measured_states += measured[k].len();
+                    beyond += measured[k].difference(reached[k]).len();
+                }
             }
-            for k in 0..3 {
-                measured_states += measured[k].len();
-                beyond += measured[k].difference(reached[k]).len();
-            }
+            eprintln!(
+                "δ = {delta} rad, ranged {ranged}: {beyond} of {measured_states} measured states beyond the sampled and nominal ones"
+            );
+            assert!(
+                beyond * 100 <= 3 * measured_states,
+                "δ = {delta}, ranged {ranged}: {beyond} of {measured_states}"
+            );
         }
-        eprintln!(
-            "δ = {delta} rad: {beyond} of {measured_states} measured states beyond the sampled and nominal ones"
-        );
-        assert!(
-            beyond * 100 <= 3 * measured_states,
-            "δ = {delta}: {beyond} of {measured_states}"
-        );
     }
 }

@@ -1389,6 +1389,26 @@ fn argument_cases() -> Vec<Case> {
             &["--uncertainty NaN"],
         ),
         Case::new(
+            "measure: two range intervals for three landmarks",
+            "measure 0 40 100 --ranges 4:5,8:10",
+            &["three intervals"],
+        ),
+        Case::new(
+            "measure: a range interval that is not one",
+            "measure 0 40 100 --ranges 4-5,-,-",
+            &["\"4-5\"", "LOW:HIGH"],
+        ),
+        Case::new(
+            "measure: a range interval upside down",
+            "measure 0 40 100 --ranges 5:4,-,-",
+            &["range interval of landmark 0 is [5, 4]"],
+        ),
+        Case::new(
+            "measure: range intervals against the order",
+            "measure 0 40 100 --order A<B --ranges 8:10,4:5,-",
+            &["landmark 0 is ordered nearer than landmark 1"],
+        ),
+        Case::new(
             "map check: --calculus of no calculus",
             "map check {dir}/net.txt --calculus xdc",
             &["invalid value 'xdc' for '--calculus"],

@@ -68,16 +68,23 @@ fn unary(calculus: &str, operator: &str, set: &str) -> PyResult<Vec<u8>> {
         .map_err(errors::qrm)
 }
 
-/// The relations AB:C, BC:A, CA:B, BA:C, CB:A, AC:B of one triple from its bearings in degrees
-/// and range order (000 §IV).
+/// The relations AB:C, BC:A, CA:B, BA:C, CB:A, AC:B of one triple from its bearings in degrees,
+/// range order and range intervals (`pipeline measure --ranges`; 000 §IV).
 #[pyfunction]
 fn measure(
     calculus: &str,
     bearings: [f64; 3],
     order: &str,
     uncertainty: f64,
+    ranges: &str,
 ) -> PyResult<Vec<Vec<u8>>> {
-    let sets =
-        relations(calculus_named(calculus)?, bearings, order, uncertainty).map_err(errors::qrm)?;
+    let sets = relations(
+        calculus_named(calculus)?,
+        bearings,
+        order,
+        uncertainty,
+        ranges,
+    )
+    .map_err(errors::qrm)?;
     Ok(sets.into_iter().map(members).collect())
 }

@@ -50,6 +50,16 @@ def test_measure_matches_cli(cli):
         assert {k: cli_set(v) for k, v in theirs.items()} == mine
 
 
+def test_measure_with_ranges_matches_cli_and_narrows(cli):
+    bearings, order = [0.0, 40.0, 100.0], "A<B<C"
+    mine = qrm.measure(bearings, order, ranges=[(4, 5), (8, 10), None])
+    out = cli("measure", *bearings, "--order", order, "--ranges", "4:5,8:10,-").stdout
+    theirs = dict(line.split(" = ") for line in out.strip().splitlines())
+    assert {k: cli_set(v) for k, v in theirs.items()} == mine
+    loose = qrm.measure(bearings, order)
+    assert all(mine[k] <= loose[k] for k in loose) and mine != loose
+
+
 def test_measure_takes_pairs_and_arrays():
     a = qrm.measure(np.array([0.0, 40.0, 100.0]), "A<B<C")
     b = qrm.measure([0, 40, 100], [(0, 1), (1, 2)])
@@ -66,6 +76,8 @@ def test_measure_takes_pairs_and_arrays():
         (lambda: qrm.measure([0, 1, 2], "A<D"), qrm.QrmError),
         (lambda: qrm.measure([0, 1, 2], "A<B,B<A"), qrm.QrmError),
         (lambda: qrm.measure([0, 1, 2], uncertainty=90), qrm.QrmError),
+        (lambda: qrm.measure([0, 1, 2], ranges=[(1, 2)]), ValueError),
+        (lambda: qrm.measure([0, 1, 2], ranges=[(2, 1), None, None]), qrm.QrmError),
         (lambda: qrm.classify((0, 0), (0, 0), (1, 1)), qrm.QrmError),
         (lambda: qrm.classify((0, 0), (0, float("inf")), (1, 1)), ValueError),
         (lambda: qrm.classify((0, 0, 0), (0, 1), (1, 1)), ValueError),

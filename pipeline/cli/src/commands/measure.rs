@@ -6,7 +6,9 @@ use clap::Args;
 use qrm_core::calculus::{Calculus, RelationSet};
 use qrm_core::edc::Edc;
 use qrm_core::fdc::Fdc;
-use qrm_core::measurement::{Bearing, RangeOrder, StationView, MAX_BEARING_UNCERTAINTY};
+use qrm_core::measurement::{
+    Bearing, RangeBounds, RangeOrder, StationView, MAX_BEARING_UNCERTAINTY,
+};
 
 #[derive(Args, Debug)]
 pub struct MeasureArgs {
@@ -26,8 +28,46 @@ pub struct MeasureArgs {
     /// Bearing uncertainty: each true bearing lies within ± this many degrees.
     #[arg(long, default_value_t = 0.0)]
     uncertainty: f64,
+    /// Range intervals of A, B, C, comma-separated, each `LOW:HIGH` (any unit; HIGH may be
+    /// `inf`) or `-` for unknown: the ratios of the ranges are then bounded too, beyond the
+    /// order. Empty: no intervals.
+    #[arg(long, default_value = "", allow_hyphen_values = true)]
+    ranges: String,
     #[arg(long, value_enum, default_value = "edc")]
     calculus: CalculusName,
+}
+
+/// `4:5,8:10,-` → the range intervals of A, B, C (`-`: unbounded); empty: all unbounded.
+pub fn parse_ranges(text: &str) -> Result<Vec<RangeBounds>> {
+    if text.trim().is_empty() {
+        return Ok(vec![RangeBounds::UNBOUNDED; 3]);
+    }
+    let items: Vec<&str> = text.split(',').map(str::trim).collect();
+    if items.len() != 3 {
+        bail!(
+            "--ranges {text:?} must give three intervals (A, B, C) separated by commas, e.g. 4:5,8:10,-"
+        );
+    }
+    items
+        .into_iter()
+        .map(|item| {
+            if item == "-" {
+                return Ok(RangeBounds::UNBOUNDED);
+            }
+            let (low, high) = item
+                .split_once(':')
+                .with_context(|| format!("range interval {item:?} must look like LOW:HIGH or -"))?;
+            let number = |v: &str| {
+                v.trim()
+                    .parse::<f64>()
+                    .with_context(|| format!("{v:?} in range interval {item:?} is not a number"))
+            };
+            Ok(RangeBounds {
+                low: number(low)?,
+                high: number(high)?,
+            })
+        })
+        .collect()
 }
 
 /// `A<B<C`, `A<B,A<C` → pairs of indices (0 = A), nearer first.
@@ -57,6 +97,7 @@ pub fn run(args: MeasureArgs) -> Result<()> {
         [args.a, args.b, args.c],
         &args.order,
         args.uncertainty,
+        &args.ranges,
     )?;
     for (name, set) in RELATION_NAMES.iter().zip(relations) {
         println!("{name} = {set}");
@@ -69,13 +110,16 @@ pub const RELATION_NAMES: [&str; 6] = ["AB:C", "BC:A", "CA:B", "BA:C", "CB:A", "
 
 /// The relations of landmarks A, B, C seen at bearings `degrees` (counter-clockwise, any
 /// zero, each within ±`uncertainty` degrees) with the range `order` (`A<B<C`, `A<B,A<C`, or
-/// empty), in the order of [`RELATION_NAMES`] (000 §IV).
+/// empty) and range intervals `ranges` ([`parse_ranges`]), in the order of
+/// [`RELATION_NAMES`] (000 §IV).
 pub fn relations(
     calculus: CalculusName,
     degrees: [f64; 3],
     order: &str,
     uncertainty: f64,
+    ranges: &str,
 ) -> Result<[RelationSet; 6]> {
+    let ranges = parse_ranges(ranges)?;
     let pairs = parse_order(order)?;
     let order = RangeOrder::from_pairs(3, &pairs).context("range order")?;
     if !(0.0..MAX_BEARING_UNCERTAINTY.to_degrees()).contains(&uncertainty) {
@@ -92,7 +136,7 @@ pub fn relations(
             uncertainty: uncertainty.to_radians(),
         })
         .collect();
-    let panorama = StationView::new(bearings, order)?;
+    let panorama = StationView::new(bearings, order)?.with_ranges(ranges)?;
     Ok(match calculus {
         CalculusName::Edc => measured::<Edc>(&panorama),
         CalculusName::Fdc => measured::<Fdc>(&panorama),

@@ -17,6 +17,7 @@
 //! observation allows — exactly it, up to the regions whose boundary lies within the
 //! enclosures' width of an allowed arrangement.
 
+use super::range_ratios::RangeRatios;
 use super::Bearing;
 use crate::calculus::RelationSet;
 use crate::edc::SIGNS;
@@ -107,10 +108,12 @@ fn direction(b: &Bearing) -> (Interval, Interval) {
 }
 
 /// The regions of `AB:C`, `BC:A`, `CA:B` among `candidates` that cannot be ruled out, given
+/// the range order `nearer` and the range ratios it and the ranging allow (`bounds`), and
 /// that `known` are possible already (e.g. reached at the nominal bearings).
 pub fn by_intervals(
     bearings: [Bearing; 3],
     nearer: &[(usize, usize)],
+    bounds: &RangeRatios,
     candidates: [RelationSet; 3],
     known: [RelationSet; 3],
 ) -> [RelationSet; 3] {
@@ -123,8 +126,11 @@ pub fn by_intervals(
             })
         })
     });
-    let (others, start) = ratio_box(nearer);
+    let (others, start) = ratio_box(nearer, bounds);
     let mut kept = known;
+    if start.iter().any(|r| r.lo > r.hi) {
+        return kept;
+    }
     let mut pending: [RelationSet; 3] = std::array::from_fn(|k| candidates[k].difference(known[k]));
     // Each box carries the regions its ancestors could not rule out: an enclosure over a
     // sub-box lies within the enclosure over the box, so what a box excludes stays excluded
@@ -146,7 +152,9 @@ pub fn by_intervals(
         for (slot, &i) in others.iter().enumerate() {
             ranges[i] = ratios[slot];
         }
-        if nearer.iter().any(|&(p, q)| ranges[p].lo >= ranges[q].hi) {
+        if nearer.iter().any(|&(p, q)| ranges[p].lo >= ranges[q].hi)
+            || outside(&ranges, bounds, others)
+        {
             continue;
         }
         let largest = ranges.iter().map(|r| r.hi).fold(0.0, f64::max);
@@ -351,10 +359,18 @@ fn tightened(labelled: &Labelled, values: [Interval; 6]) -> [Interval; 6] {
     })
 }
 
+/// Whether the box's ranges (relative to the reference) break a bound on some ratio of two of
+/// them everywhere: the pair of the two others, whose ratio is not one of the box's sides.
+fn outside(ranges: &[Interval; 3], ratios: &RangeRatios, [p, q]: [usize; 2]) -> bool {
+    let (lo, hi) = ratios.of(p, q);
+    ranges[p].lo > hi * ranges[q].hi || ranges[p].hi < lo * ranges[q].lo
+}
+
 /// The two landmarks other than the reference, and the box of their log range ratios to it
-/// that the range order `nearer` allows: for a reference that every ordered pair involves (or
-/// whose pairs imply it), the order is the box's bounds. Any partial order of three has one.
-fn ratio_box(nearer: &[(usize, usize)]) -> ([usize; 2], [Interval; 2]) {
+/// that the range order `nearer` and the ranging (`ratios`) allow: for a reference that every
+/// ordered pair involves (or whose pairs imply it), the order is the box's bounds. Any partial
+/// order of three has one. A side is empty (`lo > hi`) when nothing fits.
+fn ratio_box(nearer: &[(usize, usize)], ratios: &RangeRatios) -> ([usize; 2], [Interval; 2]) {
     let limit = MAX_RANGE_RATIO.ln();
     let ordered = |p: usize, q: usize| nearer.contains(&(p, q));
     let explained = |r: usize| {
@@ -365,13 +381,15 @@ fn ratio_box(nearer: &[(usize, usize)]) -> ([usize; 2], [Interval; 2]) {
     let reference = (0..3).find(|&r| explained(r)).unwrap_or(0);
     let others = [(reference + 1) % 3, (reference + 2) % 3];
     let bounds = others.map(|i| {
-        if ordered(i, reference) {
+        let order = if ordered(i, reference) {
             Interval::new(-limit, 0.0)
         } else if ordered(reference, i) {
             Interval::new(0.0, limit)
         } else {
             Interval::new(-limit, limit)
-        }
+        };
+        let (lo, hi) = ratios.of(i, reference);
+        Interval::new(order.lo.max(lo.ln()), order.hi.min(hi.ln()))
     });
     (others, bounds)
 }

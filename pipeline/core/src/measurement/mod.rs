@@ -8,11 +8,13 @@
 
 mod interval;
 mod range_order;
+mod range_ratios;
 mod sweep;
 mod triple;
 
 pub use interval::by_intervals;
 pub use range_order::{RangeOrder, RangeOrderError};
+pub use range_ratios::{RangeBounds, RangeRatios};
 pub use sweep::sweep_regions;
 pub use triple::{by_search, by_sweep, measure_triple_edc, TripleRelations};
 
@@ -61,6 +63,9 @@ pub fn angular_distance(a: f64, b: f64) -> f64 {
 pub struct StationView {
     pub bearings: Vec<Bearing>,
     pub order: RangeOrder,
+    /// Each landmark's range interval, where ranging bounds it beyond the order
+    /// ([`StationView::with_ranges`]; unbounded otherwise).
+    pub ranges: Vec<RangeBounds>,
 }
 
 /// An observation that cannot be measured.
@@ -76,6 +81,14 @@ pub enum MeasurementError {
     BadUncertainty { index: usize, value: f64, max: f64 },
     #[error("the range order covers {order} landmarks but the panorama has {bearings} bearings")]
     OrderSize { order: usize, bearings: usize },
+    #[error("{ranges} range intervals given for a panorama of {bearings} bearings")]
+    RangesSize { ranges: usize, bearings: usize },
+    #[error(
+        "range interval of landmark {index} is [{low}, {high}]; it must satisfy 0 ≤ low ≤ high"
+    )]
+    BadRange { index: usize, low: f64, high: f64 },
+    #[error("landmark {nearer} is ordered nearer than landmark {farther}, but their range intervals say it is farther")]
+    RangesContradictOrder { nearer: usize, farther: usize },
 }
 
 impl StationView {
@@ -108,7 +121,44 @@ impl StationView {
                 bearings: bearings.len(),
             });
         }
-        Ok(StationView { bearings, order })
+        let ranges = vec![RangeBounds::UNBOUNDED; bearings.len()];
+        Ok(StationView {
+            bearings,
+            order,
+            ranges,
+        })
+    }
+
+    /// The view with each landmark's range in an interval (`ranges[i]` for position `i`; any
+    /// unit, only ratios are used): measured triples then also keep the ratios the intervals
+    /// allow. The intervals must hold the order: a landmark ordered nearer than another cannot
+    /// have its interval entirely beyond the other's.
+    pub fn with_ranges(self, ranges: Vec<RangeBounds>) -> Result<StationView, MeasurementError> {
+        if ranges.len() != self.bearings.len() {
+            return Err(MeasurementError::RangesSize {
+                ranges: ranges.len(),
+                bearings: self.bearings.len(),
+            });
+        }
+        for (index, r) in ranges.iter().enumerate() {
+            if !(r.low >= 0.0 && r.low.is_finite() && r.high >= r.low) {
+                return Err(MeasurementError::BadRange {
+                    index,
+                    low: r.low,
+                    high: r.high,
+                });
+            }
+        }
+        for nearer in 0..ranges.len() {
+            for farther in 0..ranges.len() {
+                if self.order.is_nearer(nearer, farther)
+                    && ranges[nearer].low >= ranges[farther].high
+                {
+                    return Err(MeasurementError::RangesContradictOrder { nearer, farther });
+                }
+            }
+        }
+        Ok(StationView { ranges, ..self })
     }
 
     pub fn len(&self) -> usize {
@@ -127,8 +177,9 @@ impl StationView {
         open: TripleRelations,
     ) -> TripleRelations {
         let bearings = landmarks.map(|i| self.bearings[i]);
+        let ranges = landmarks.map(|i| self.ranges[i]);
         let nearer = self.order.restricted(&landmarks);
-        match measure_triple_edc(bearings, &nearer, open.map(edc_candidates::<C>)) {
+        match measure_triple_edc(bearings, &nearer, ranges, open.map(edc_candidates::<C>)) {
             Some(regions) => std::array::from_fn(|k| C::from_edc(regions[k]).intersection(open[k])),
             None => open,
         }

@@ -9,8 +9,9 @@
 //!   vertex is a fixed similarity-covariant point, affine in `r` — one linear equation;
 //! - a circle becomes tangent to the ray (a double root): a quadratic in `r`;
 //! - a line becomes parallel to the ray (a root escapes to infinity): linear in `r`;
-//! - a root meets an end of the allowed `s` interval: the camera (`s = 0`), `|C| = |A|`
-//!   (`s = 1`) or `|C| = |B|` (`s = r`): quadratics in `r`.
+//! - a root meets an end of the allowed `s` interval: the camera (`s = 0`), a bound on C's
+//!   range ratio to A (`s = c`, e.g. `|C| = |A|` at 1) or to B (`s = k·r`): quadratics in `r`;
+//! - the two kinds of end swap (`c = k·r`): linear in `r`.
 //!
 //! Between consecutive critical values the sequence is constant, and a region met exactly at a
 //! critical value is met just beside it too (regions are open). So one `r` inside every gap and
@@ -19,6 +20,7 @@
 //! so sampling a numerically tiny interval can add a neighbour but never lose a region; and no
 //! gap is skipped, however narrow.
 
+use super::range_ratios::RangeRatios;
 use crate::calculus::RelationSet;
 use crate::edc::region_of_signs;
 use crate::geometry::{boundary_values, Coordinate, Point, Point2};
@@ -54,15 +56,14 @@ const ZERO_TOLERANCE: f64 = 1e-9;
 const COEFFICIENT_NOISE: f64 = 64.0 * f64::EPSILON;
 
 /// The EDC regions of `AB:C` reachable when A, B, C lie on the rays `u` (unit vectors, camera
-/// at the origin) with ranges ordered by `nearer` (`(p, q)`: landmark `p` of `[A, B, C]` is
-/// nearer than `q`; transitively closed), among `wanted` (the sweep stops once all are found).
-pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationSet) -> RelationSet {
-    let is_nearer = |p: usize, q: usize| nearer.contains(&(p, q));
+/// at the origin) with range ratios within `ratios` (which holds the range order: a landmark
+/// nearer than another has a ratio to it below 1), among `wanted` (the sweep stops once all
+/// are found).
+pub fn sweep_regions(u: [Point; 3], ratios: &RangeRatios, wanted: RelationSet) -> RelationSet {
     let functions = BoundaryPolynomials::new(u);
 
     // Allowed r: B vs A.
-    let r_lo = if is_nearer(0, 1) { 1.0 } else { 0.0 };
-    let r_hi = if is_nearer(1, 0) { 1.0 } else { f64::INFINITY };
+    let (r_lo, r_hi) = ratios.of(1, 0);
 
     // A few typical ranges first: when every wanted region shows up there (the usual case once
     // the map is tight), the critical values are never needed.
@@ -70,15 +71,15 @@ pub fn sweep_regions(u: [Point; 3], nearer: &[(usize, usize)], wanted: RelationS
     let mut roots = Vec::with_capacity(16);
     for r in PROBE_RANGES {
         if r > r_lo && r < r_hi {
-            found = found.union(regions_along_ray(&functions, nearer, r, &mut roots));
+            found = found.union(regions_along_ray(&functions, ratios, r, &mut roots));
             if wanted.is_subset(found) {
                 return wanted;
             }
         }
     }
-    let mut critical = critical_ranges(u, &functions);
+    let mut critical = critical_ranges(u, &functions, ratios);
     for r in gap_samples(&mut critical, r_lo, r_hi) {
-        found = found.union(regions_along_ray(&functions, nearer, r, &mut roots));
+        found = found.union(regions_along_ray(&functions, ratios, r, &mut roots));
         if wanted.is_subset(found) {
             break;
         }
@@ -101,26 +102,11 @@ const PROBE_RANGES: [f64; 6] = [0.3, 0.6, 0.9, 1.1, 1.6, 3.0];
 /// The regions C meets on its ray (within the allowed ranges) when `|B| = r·|A|`.
 fn regions_along_ray(
     functions: &BoundaryPolynomials,
-    nearer: &[(usize, usize)],
+    ratios: &RangeRatios,
     r: f64,
     roots: &mut Vec<f64>,
 ) -> RelationSet {
-    let is_nearer = |p: usize, q: usize| nearer.contains(&(p, q));
-    // Allowed s: C vs A (s vs 1) and C vs B (s vs r).
-    let mut s_lo: f64 = 0.0;
-    let mut s_hi = f64::INFINITY;
-    if is_nearer(0, 2) {
-        s_lo = s_lo.max(1.0);
-    }
-    if is_nearer(2, 0) {
-        s_hi = s_hi.min(1.0);
-    }
-    if is_nearer(1, 2) {
-        s_lo = s_lo.max(r);
-    }
-    if is_nearer(2, 1) {
-        s_hi = s_hi.min(r);
-    }
+    let [s_lo, s_hi] = allowed_s(ratios, r);
     let mut found = RelationSet::EMPTY;
     if s_lo >= s_hi {
         return found;
@@ -135,9 +121,33 @@ fn regions_along_ray(
     found
 }
 
+/// Allowed `s = |C| / |A|` when `|B| = r·|A|`: C's ratio to A, and to B times `r`.
+fn allowed_s(ratios: &RangeRatios, r: f64) -> [f64; 2] {
+    let (to_a_lo, to_a_hi) = ratios.of(2, 0);
+    let (to_b_lo, to_b_hi) = ratios.of(2, 1);
+    [to_a_lo.max(to_b_lo * r), to_a_hi.min(to_b_hi * r)]
+}
+
 /// The values of `r` at which the sequence of regions along C's ray can change (module doc).
-fn critical_ranges(u: [Point; 3], functions: &BoundaryPolynomials) -> Vec<f64> {
+fn critical_ranges(
+    u: [Point; 3],
+    functions: &BoundaryPolynomials,
+    ratios: &RangeRatios,
+) -> Vec<f64> {
     let mut critical = vec![1.0];
+    // Where the end set by C's ratio to A and the end set by its ratio to B swap.
+    let (to_a_lo, to_a_hi) = ratios.of(2, 0);
+    let (to_b_lo, to_b_hi) = ratios.of(2, 1);
+    let to_a = [to_a_lo, to_a_hi, 1.0]
+        .into_iter()
+        .filter(|c| c.is_finite() && *c > 0.0);
+    let to_b: Vec<f64> = [to_b_lo, to_b_hi, 1.0]
+        .into_iter()
+        .filter(|k| k.is_finite() && *k > 0.0)
+        .collect();
+    for c in to_a.clone() {
+        critical.extend(to_b.iter().map(|k| c / k));
+    }
     for &(alpha, beta) in &VERTICES {
         // V(r) = P + r·Q with A = u_A, B = r·u_B; on the ray ⇔ cross(u_C, V) = 0.
         let p = Point::new(
@@ -154,9 +164,24 @@ fn critical_ranges(u: [Point; 3], functions: &BoundaryPolynomials) -> Vec<f64> {
         // f = ss·s² + (rs·r + s1)·s + (rr·r² + r1·r + c).
         push_roots(&mut critical, 0.0, f.rs, f.s); // parallel line: the s-coefficient vanishes
         push_roots(&mut critical, f.rr, f.r, f.c); // camera on the boundary
-        push_roots(&mut critical, f.rr, f.r + f.rs, f.c + f.s + f.ss); // s = 1
-        push_roots(&mut critical, f.rr + f.rs + f.ss, f.r + f.s, f.c); // s = r
-                                                                       // Discriminant (rs·r + s1)² − 4·ss·(rr·r² + r1·r + c) = 0.
+                                                   // A root at an end of the allowed s: s = c (a ratio to A) or s = k·r (to B).
+        for c in to_a.clone() {
+            push_roots(
+                &mut critical,
+                f.rr,
+                f.r + f.rs * c,
+                f.c + (f.s + f.ss * c) * c,
+            );
+        }
+        for &k in &to_b {
+            push_roots(
+                &mut critical,
+                f.rr + (f.rs + f.ss * k) * k,
+                f.r + f.s * k,
+                f.c,
+            );
+        }
+        // Discriminant (rs·r + s1)² − 4·ss·(rr·r² + r1·r + c) = 0.
         push_roots(
             &mut critical,
             f.rs * f.rs - 4.0 * f.ss * f.rr,

@@ -14,6 +14,7 @@
 //! paper's two-unknown problem; each uncertain bearing adds one unknown.
 
 use super::interval::by_intervals;
+use super::range_ratios::{RangeBounds, RangeRatios};
 use super::sweep::sweep_regions;
 use super::Bearing;
 use crate::calculus::{Calculus, RelationSet};
@@ -26,14 +27,15 @@ use crate::geometry::{Coordinate, Point, Point2};
 pub type TripleRelations = [RelationSet; 3];
 
 /// The EDC regions of `AB:C`, `BC:A`, `CA:B` (in that order) consistent with the bearings of
-/// `A`, `B`, `C` and the ordered pairs `nearer` (`(p, q)`: landmark `p` of the triple is nearer
-/// than `q`), restricted to `candidates`: by [`by_sweep`] for exact bearings, otherwise the
-/// regions reached at the nominal bearings plus those [`by_intervals`] cannot rule out. `None` when
-/// the bearings are exact and collinear: every arrangement then lies on the line AB, where no
-/// EDC region is defined, and nothing is learnt.
+/// `A`, `B`, `C`, the ordered pairs `nearer` (`(p, q)`: landmark `p` of the triple is nearer
+/// than `q`) and the range intervals `ranges`, restricted to `candidates`: by [`by_sweep`] for
+/// exact bearings, otherwise the regions reached at the nominal bearings plus those
+/// [`by_intervals`] cannot rule out. `None` when the bearings are exact and collinear: every
+/// arrangement then lies on the line AB, where no EDC region is defined, and nothing is learnt.
 pub fn measure_triple_edc(
     bearings: [Bearing; 3],
     nearer: &[(usize, usize)],
+    ranges: [RangeBounds; 3],
     candidates: TripleRelations,
 ) -> Option<TripleRelations> {
     if all_collinear(&bearings) {
@@ -61,12 +63,14 @@ pub fn measure_triple_edc(
     let nominal = by_sweep(
         bearings.map(|b| Bearing::exact(b.angle)),
         nearer,
+        ranges,
         candidates,
     );
     Some(if bearings.iter().all(|b| b.uncertainty == 0.0) {
         nominal
     } else {
-        by_intervals(bearings, nearer, candidates, nominal)
+        let ratios = RangeRatios::new(ranges, nearer);
+        by_intervals(bearings, nearer, &ratios, candidates, nominal)
     })
 }
 
@@ -74,21 +78,18 @@ pub fn measure_triple_edc(
 pub fn by_sweep(
     bearings: [Bearing; 3],
     nearer: &[(usize, usize)],
+    ranges: [RangeBounds; 3],
     candidates: TripleRelations,
 ) -> TripleRelations {
     let u = bearings.map(|b| Point::new(b.angle.cos(), b.angle.sin()));
+    let ratios = RangeRatios::new(ranges, nearer);
     std::array::from_fn(|k| {
         if candidates[k].is_empty() {
             return RelationSet::EMPTY;
         }
-        let rotate = |p: usize| (p + 3 - k) % 3;
-        let nearer: Vec<(usize, usize)> = nearer
-            .iter()
-            .map(|&(p, q)| (rotate(p), rotate(q)))
-            .collect();
         sweep_regions(
             [u[k], u[(k + 1) % 3], u[(k + 2) % 3]],
-            &nearer,
+            &ratios.rotated(k),
             candidates[k],
         )
     })
@@ -100,10 +101,11 @@ pub fn by_sweep(
 pub fn by_search(
     bearings: [Bearing; 3],
     nearer: &[(usize, usize)],
+    ranges: [RangeBounds; 3],
     candidates: TripleRelations,
     engine: &BranchAndBound,
 ) -> TripleRelations {
-    let formulation = Formulation::new(&bearings, nearer);
+    let formulation = Formulation::new(&bearings, nearer, &RangeRatios::new(ranges, nearer));
     let mut index = Vec::new();
     let mut alternatives = Vec::new();
     for (k, set) in candidates.iter().enumerate() {
@@ -150,7 +152,11 @@ struct Formulation {
 }
 
 impl Formulation {
-    fn new(bearings: &[Bearing; 3], nearer: &[(usize, usize)]) -> Formulation {
+    fn new(
+        bearings: &[Bearing; 3],
+        nearer: &[(usize, usize)],
+        ratios: &RangeRatios,
+    ) -> Formulation {
         let uncertain: Vec<usize> = (0..3).filter(|&i| bearings[i].uncertainty > 0.0).collect();
         let n = 2 + uncertain.len();
         let mut lower = vec![0.0; n];
@@ -194,6 +200,18 @@ impl Formulation {
             } else {
                 squared_norm(&points[p]) - squared_norm(&points[q])
             });
+        }
+        // Ranging's bounds lo ≤ |P| / |Q| ≤ hi, as lo²·|Q|² − |P|² ≤ 0 and |P|² − hi²·|Q|² ≤ 0.
+        for p in 0..3 {
+            for q in (0..3).filter(|&q| q != p) {
+                let (lo, hi) = ratios.of(p, q);
+                if hi.is_finite() {
+                    common.push(squared_norm(&points[p]) - squared_norm(&points[q]) * (hi * hi));
+                }
+                if lo > 0.0 {
+                    common.push(squared_norm(&points[q]) * (lo * lo) - squared_norm(&points[p]));
+                }
+            }
         }
         Formulation {
             points,

@@ -162,18 +162,41 @@ def measure(
     order: Union[str, Sequence[Tuple[Any, Any]]] = "",
     uncertainty: float = 0.0,
     calculus: str = "edc",
+    ranges: Optional[Sequence[Optional[Tuple[float, float]]]] = None,
 ) -> dict:
     """The relations of landmarks A, B, C seen at ``bearings`` (three angles in degrees,
     counter-clockwise, any zero, each true within ± ``uncertainty``) with the range ``order``
     (``"A<B<C"``, ``"A<B,A<C"``, pairs such as ``[(0, 1), (1, 2)]`` nearer first, or empty for
-    no order), as 000 §IV measures them: ``{"AB:C": frozenset, "BC:A": …, …}``."""
+    no order) and, optionally, each landmark's range within ``ranges[i] = (low, high)`` (any
+    unit, ``None`` for unknown; the ratios of ranges are then bounded too), as 000 §IV measures
+    them: ``{"AB:C": frozenset, "BC:A": …, …}``."""
     b = _numbers(bearings, "bearings")
     if b.shape != (3,):
         raise ValueError(f"bearings must hold three angles, got shape {b.shape}")
     sets = _qrm.measure(
-        calculus, b.tolist(), _order_text(order), _degrees(uncertainty, "uncertainty")
+        calculus,
+        b.tolist(),
+        _order_text(order),
+        _degrees(uncertainty, "uncertainty"),
+        _ranges_text(ranges),
     )
     return {name: frozenset(s) for name, s in zip(RELATION_NAMES, sets)}
+
+
+def _ranges_text(ranges: Optional[Sequence[Optional[Tuple[float, float]]]]) -> str:
+    """Range intervals as ``pipeline measure --ranges`` takes them (``4:5,8:10,-``)."""
+    if ranges is None:
+        return ""
+    if isinstance(ranges, str) or len(ranges) != 3:
+        raise ValueError("ranges must hold three (low, high) intervals or None, one per landmark")
+    items = []
+    for r in ranges:
+        if r is None:
+            items.append("-")
+            continue
+        low, high = (float(v) for v in r)
+        items.append(f"{low!r}:{high!r}")
+    return ",".join(items)
 
 
 def _write_atomic(path: PathLike, text: str) -> None:
