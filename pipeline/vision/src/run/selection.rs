@@ -131,13 +131,16 @@ pub(crate) fn placement(bearing: f64, uncertainty: f64, [low, high]: [f64; 2]) -
     })
 }
 
-/// The view of the detections at `usable` (bearings and the range order among them).
+/// The view of the detections at `usable`: bearings, the range order among them, and the
+/// range intervals that bound their ratios ([`ranging::ratio_bounds`]).
 pub(super) fn view_of(ranged: &[Ranged], usable: &[usize]) -> StationView {
     let chosen: Vec<Ranged> = usable.iter().map(|&i| ranged[i]).collect();
     let bearings: Vec<Bearing> = chosen.iter().map(|r| r.bearing).collect();
     let order: RangeOrder = ranging::range_order(&chosen);
+    let ranges = chosen.iter().map(ranging::ratio_bounds).collect();
     StationView::new(bearings, order)
-        .expect("bearings are finite, in range, with uncertainty below the limit")
+        .and_then(|view| view.with_ranges(ranges))
+        .expect("bearings are finite, in range, with uncertainty below the limit; the order is the intervals'")
 }
 
 #[cfg(test)]
