@@ -65,7 +65,7 @@ pub struct Location {
     pub ambiguous: Vec<(usize, Vec<LandmarkId>)>,
     pub whereabouts: Whereabouts,
     /// The identified landmarks as the leg follower sees them (000 §VII-B): their ids, and
-    /// their bearings and range order by position in that list.
+    /// their bearings, range order and range intervals by position in that list.
     #[serde(skip)]
     pub seen: (Vec<LandmarkId>, StationView),
     /// Every detection's range interval from all cues (`Ranged::fused`), metres, by detection:
@@ -163,12 +163,22 @@ impl<C: Calculus> KnownMap<C> {
             .filter(|&i| !(0..ranged.len()).any(|j| order.is_nearer(j, i)))
             .collect();
         let indices: Vec<usize> = identified.iter().map(|p| p.0).collect();
+        // Measured as mapping measures a station (`run::selection::view_of`): the range
+        // ratios bounded where ground and stereo agree.
         let seen = StationView::new(
             indices.iter().map(|&i| ranged[i].bearing).collect(),
             RangeOrder::from_pairs(indices.len(), &order.restricted(&indices))
                 .expect("a sub-order of a strict order"),
         )
-        .expect("bearings of usable detections are measurable");
+        .and_then(|view| {
+            view.with_ranges(
+                indices
+                    .iter()
+                    .map(|&i| ranging::ratio_bounds(&ranged[i]))
+                    .collect(),
+            )
+        })
+        .expect("bearings of usable detections are measurable; the order is the intervals'");
         let mut whereabouts = whereabouts(&nearest, &identified);
         if matches!(whereabouts, Whereabouts::Certain { .. }) && !self.agrees(&identified, &seen) {
             whereabouts = Whereabouts::Unknown;
