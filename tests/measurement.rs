@@ -137,6 +137,29 @@ fn range_intervals_never_exclude_the_true_region() {
     assert_eq!(violations::<Edc>(40_000, 0.05, true, 9), 0);
 }
 
+/// A random partial order of three landmarks (`(p, q)`: `p` nearer) and, if `ranged`, range
+/// intervals around random true ranges that the order is a part of; without, any order of
+/// the pairs `(0, 1)`, `(1, 2)`, `(0, 2)` and no intervals.
+fn random_order_and_ranges(
+    rng: &mut ChaCha8Rng,
+    ranged: bool,
+) -> (Vec<(usize, usize)>, [RangeBounds; 3]) {
+    if !ranged {
+        let pairs = [(0, 1), (1, 2), (0, 2)]
+            .into_iter()
+            .filter(|_| rng.random_bool(0.6))
+            .collect();
+        return (pairs, [RangeBounds::UNBOUNDED; 3]);
+    }
+    let truth: [f64; 3] = std::array::from_fn(|_| 10f64.powf(rng.random_range(-1.0..1.0)));
+    let pairs = (0..3)
+        .flat_map(|p| (0..3).map(move |q| (p, q)))
+        .filter(|&(p, q)| truth[p] < truth[q])
+        .filter(|_| rng.random_bool(0.6))
+        .collect();
+    (pairs, truth.map(|r| random_range_bounds(rng, r)))
+}
+
 /// A range inside `bounds` (log-uniform), or anywhere over four decades when unbounded.
 fn sampled_range(rng: &mut ChaCha8Rng, bounds: RangeBounds) -> f64 {
     if bounds.low > 0.0 && bounds.high.is_finite() {
@@ -228,21 +251,7 @@ fn sweep_agrees_with_branch_and_bound() {
     for scene in 0..300 {
         let bearings: [Bearing; 3] =
             std::array::from_fn(|_| Bearing::exact(rng.random_range(-3.2..3.2)));
-        let (pairs, ranges) = if scene < 150 {
-            let pairs: Vec<(usize, usize)> = [(0, 1), (1, 2), (0, 2)]
-                .into_iter()
-                .filter(|_| rng.random_bool(0.6))
-                .collect();
-            (pairs, [RangeBounds::UNBOUNDED; 3])
-        } else {
-            let truth: [f64; 3] = std::array::from_fn(|_| 10f64.powf(rng.random_range(-1.0..1.0)));
-            let pairs: Vec<(usize, usize)> = (0..3)
-                .flat_map(|p| (0..3).map(move |q| (p, q)))
-                .filter(|&(p, q)| truth[p] < truth[q])
-                .filter(|_| rng.random_bool(0.6))
-                .collect();
-            (pairs, truth.map(|r| random_range_bounds(&mut rng, r)))
-        };
+        let (pairs, ranges) = random_order_and_ranges(&mut rng, scene >= 150);
         let nearer = RangeOrder::from_pairs(3, &pairs)
             .unwrap()
             .restricted(&[0, 1, 2]);
@@ -404,22 +413,7 @@ fn uncertain_bearings_are_measured_tightly() {
                     angle: rng.random_range(0.0..std::f64::consts::TAU),
                     uncertainty: delta,
                 });
-                let (pairs, bounds) = if ranged {
-                    let truth: [f64; 3] =
-                        std::array::from_fn(|_| 10f64.powf(rng.random_range(-1.0..1.0)));
-                    let pairs: Vec<(usize, usize)> = (0..3)
-                        .flat_map(|p| (0..3).map(move |q| (p, q)))
-                        .filter(|&(p, q)| truth[p] < truth[q])
-                        .filter(|_| rng.random_bool(0.6))
-                        .collect();
-                    (pairs, truth.map(|r| random_range_bounds(&mut rng, r)))
-                } else {
-                    let pairs: Vec<(usize, usize)> = [(0, 1), (1, 2), (0, 2)]
-                        .into_iter()
-                        .filter(|_| rng.random_bool(0.6))
-                        .collect();
-                    (pairs, [RangeBounds::UNBOUNDED; 3])
-                };
+                let (pairs, bounds) = random_order_and_ranges(&mut rng, ranged);
                 let order = RangeOrder::from_pairs(3, &pairs).unwrap();
                 let nearer = order.restricted(&[0, 1, 2]);
                 let view = StationView::new(bearings.to_vec(), order)
