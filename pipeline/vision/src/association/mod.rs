@@ -154,6 +154,10 @@ pub struct Evidence {
     /// A piece touching another detection ([`crate::ranging::Ranged::piece`]): it may be
     /// part of a rock or hold parts of two, so it observes landmarks but founds none.
     pub piece: bool,
+    /// Doubted by the detector (a piece cut at a shallow notch, or beside a nearer piece that
+    /// may hide some of it): it observes landmarks, founds none, and anchors only where every
+    /// registered frame holding the landmark pairs it ([`long_anchor`]).
+    pub doubtful: bool,
     /// Rock pixels of the detection: too few ([`MIN_FOUNDING_PIXELS`]) describe no looks.
     pub pixels: u32,
 }
@@ -190,6 +194,8 @@ pub enum Decision {
 pub enum Unfounded {
     /// A piece ([`Evidence::piece`]): part of a rock, or parts of two.
     Piece,
+    /// Doubted by the detector ([`Evidence::doubtful`]).
+    Doubtful,
     /// Fewer rock pixels than [`MIN_FOUNDING_PIXELS`].
     Small,
     /// Placed looser than any registration pairs ([`LONG_ANCHOR_RADIUS_M`]), or not at all.
@@ -215,7 +221,9 @@ pub const MIN_FOUNDING_PIXELS: u32 = 9;
 /// either way, for which 36 later sightings of it and of another rock were held back and given
 /// up; without it, the rock founded a landmark from 3.8 m, matched at 9 later stations).
 pub fn unfounded(evidence: &Evidence) -> Option<Unfounded> {
-    if evidence.piece {
+    if evidence.doubtful {
+        Some(Unfounded::Doubtful)
+    } else if evidence.piece {
         Some(Unfounded::Piece)
     } else if evidence.pixels < MIN_FOUNDING_PIXELS {
         Some(Unfounded::Small)
@@ -283,7 +291,8 @@ pub fn associate<C: Calculus>(
     } else {
         settings.min_support_without_colour
     };
-    let mut anchors = anchors(&registrations, &candidates, &placed, min_support);
+    let doubtful: Vec<bool> = evidence.iter().map(|e| e.doubtful).collect();
+    let mut anchors = anchors(&registrations, &candidates, &placed, &doubtful, min_support);
     let candidates = placed_near(candidates, &registrations, &placed);
     drop_inconsistent_anchors(map, view, &mut anchors);
     let anchored: Vec<Sighting> = anchors.iter().map(|a| Sighting::new(a.0, a.1)).collect();
@@ -462,6 +471,7 @@ fn anchors(
     registrations: &[(&Frame, Registration)],
     candidates: &[Vec<(LandmarkId, f64)>],
     placed: &[Option<Placed>],
+    doubtful: &[bool],
     min_support: usize,
 ) -> Vec<(usize, LandmarkId, f64)> {
     let mut pairs: Vec<(usize, LandmarkId)> = registrations
@@ -498,7 +508,7 @@ fn anchors(
                     })
             })
             .count();
-        let short = placed[i].is_none_or(|p| p.reach() <= ANCHOR_RADIUS_M);
+        let short = !doubtful[i] && placed[i].is_none_or(|p| p.reach() <= ANCHOR_RADIUS_M);
         2 * support > holding
             && support >= min_support
             && (short || long_anchor(&supporting().collect::<Vec<_>>(), holding, placed[i], l))
@@ -829,6 +839,7 @@ mod tests {
                 placed: Some(at(p)),
                 ray: toward(p),
                 piece: false,
+                doubtful: false,
                 pixels: 100,
             })
             .collect();
@@ -1084,12 +1095,12 @@ mod tests {
             (&near, by_sketch.clone()),
         ];
         assert_eq!(
-            anchors(&registrations, &candidates, &placed, 1),
+            anchors(&registrations, &candidates, &placed, &[false], 1),
             vec![(0, 0, 0.1)]
         );
         let far = sketch([20.0, 10.0]);
         let registrations = [(&station_frame, by_frame), (&far, by_sketch)];
-        assert!(anchors(&registrations, &candidates, &placed, 1).is_empty());
+        assert!(anchors(&registrations, &candidates, &placed, &[false], 1).is_empty());
     }
 
     /// A far rock's detection, placed 3 m deep along its bearing, anchors to the landmark two
@@ -1107,10 +1118,17 @@ mod tests {
         let landmark = frame(&[[10.0, 0.0]]);
         let anchored = |second: &Frame| {
             let registrations = [(&landmark, pairing.clone()), (second, pairing.clone())];
-            !anchors(&registrations, &candidates, &placed, 1).is_empty()
+            !anchors(&registrations, &candidates, &placed, &[false], 1).is_empty()
         };
         assert!(anchored(&landmark));
-        assert!(anchors(&[(&landmark, pairing.clone())], &candidates, &placed, 1).is_empty());
+        assert!(anchors(
+            &[(&landmark, pairing.clone())],
+            &candidates,
+            &placed,
+            &[false],
+            1
+        )
+        .is_empty());
         assert!(!anchored(&frame(&[[10.0, 0.0], [12.0, 0.0]])));
         let unmapped = |point: [f64; 2]| Frame {
             unmapped: vec![at(point)],
@@ -1120,7 +1138,37 @@ mod tests {
         assert!(anchored(&unmapped([15.0, 0.0])));
         // A detection placed within 2 m anchors on one frame's pairing.
         let near = [Some(Placed::along([10.0, 0.0], 0.0, 1.5, 0.1))];
-        assert!(!anchors(&[(&landmark, pairing)], &candidates, &near, 1).is_empty());
+        assert!(!anchors(
+            &[(&landmark, pairing.clone())],
+            &candidates,
+            &near,
+            &[false],
+            1
+        )
+        .is_empty());
+        // A detection the detector doubts anchors, however near, only as a far rock does.
+        let doubtful = |registrations: &[(&Frame, Registration)]| {
+            !anchors(registrations, &candidates, &near, &[true], 1).is_empty()
+        };
+        assert!(!doubtful(&[(&landmark, pairing.clone())]));
+        assert!(doubtful(&[
+            (&landmark, pairing.clone()),
+            (&landmark, pairing.clone())
+        ]));
+        let beside = frame(&[[10.0, 0.0], [11.0, 0.0]]);
+        assert!(!doubtful(&[
+            (&landmark, pairing.clone()),
+            (&beside, pairing)
+        ]));
+    }
+
+    /// A detection the detector doubts (a piece cut at a shallow notch, or beside a nearer
+    /// piece) founds no landmark.
+    #[test]
+    fn a_doubtful_detection_founds_no_landmark() {
+        let (_, mut station) = station(&[[5.0, 0.0], [0.0, 6.0], [-4.0, -3.0]]);
+        station.detections[1].doubtful = true;
+        only_the_second_founds_none(station, Unfounded::Doubtful);
     }
 
     #[test]

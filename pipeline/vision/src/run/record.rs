@@ -111,7 +111,8 @@ pub enum Exclusion {
     /// `stations.json` still reads.
     Behind,
     /// The detector doubts it is one whole rock: a piece cut at a shallow notch, a top
-    /// without its body, or no stereo to tell it from a shadow.
+    /// without its body, or no stereo to tell it from a shadow. Left out in luminance mode; in
+    /// colour mode, used but matched to no landmark (a doubted detection founds none).
     Doubted,
     /// Matched no landmark and placed too loosely to found one (a far rock whose range
     /// interval spans metres: `association::unfounded`).
@@ -134,6 +135,7 @@ impl From<Unfounded> for Exclusion {
     fn from(why: Unfounded) -> Exclusion {
         match why {
             Unfounded::Piece => Exclusion::Touching,
+            Unfounded::Doubtful => Exclusion::Doubted,
             Unfounded::Small => Exclusion::Small,
             Unfounded::Loose => Exclusion::Loose,
         }
