@@ -65,6 +65,22 @@ pub(super) fn exclusion(
     }
 }
 
+/// The detections [`usable`] for mapping less those the detector doubts ([`doubted`]): what
+/// localization associates. A mapping station's doubted detections only add sightings where
+/// registrations agree across stations; a panorama localized on its own leans on every pair
+/// it makes (marsyard seed 7's 40-trip drive, trip 0, on the same map: arrived in 20 steps
+/// without them, lost after 45 with them).
+pub(crate) fn usable_undoubted(
+    station: &StationDetections,
+    ranged: &[Ranged],
+    width: u32,
+) -> Vec<usize> {
+    usable(station, ranged, width)
+        .into_iter()
+        .filter(|&i| !doubted(&station.primary[i]))
+        .collect()
+}
+
 /// Whether the detector doubts the detection is one whole rock (a piece cut at a shallow
 /// notch, or beside a nearer piece that may hide some of it; by luminance also a top without
 /// its body). The farther part of a blob separated by parallax is flagged too, but its bearing
@@ -256,6 +272,8 @@ mod tests {
         let evidence = station_evidence(&station, &all, &[0, 1, 2], &model);
         let doubtful: Vec<bool> = evidence.detections.iter().map(|e| e.doubtful).collect();
         assert_eq!(doubtful, [false, false, true]);
+        // Localization leaves them out.
+        assert_eq!(usable_undoubted(&station, &all, 4096), [0, 1, 5, 6]);
         // By luminance, doubted detections and the pieces touching each other are left out.
         let station = StationDetections {
             channels: Channels::Luminance,
