@@ -155,8 +155,8 @@ pub struct Evidence {
     /// part of a rock or hold parts of two, so it observes landmarks but founds none.
     pub piece: bool,
     /// Doubted by the detector (a piece cut at a shallow notch, or beside a nearer piece that
-    /// may hide some of it): it observes landmarks, founds none, and anchors only where every
-    /// registered frame holding the landmark pairs it ([`long_anchor`]).
+    /// may hide some of it): it observes landmarks, founds none, and anchors only as a far
+    /// rock does, where every registered frame holding the landmark pairs it.
     pub doubtful: bool,
     /// Rock pixels of the detection: too few ([`MIN_FOUNDING_PIXELS`]) describe no looks.
     pub pixels: u32,

@@ -29,9 +29,9 @@ pub(crate) fn usable(station: &StationDetections, ranged: &[Ranged], width: u32)
 /// is too uncertain to measure with, and in luminance mode those the detector doubts
 /// ([`doubted`]) and pieces touching another. In colour mode pieces touching another are used,
 /// with their bearings and ranges widened over the neighbour ([`Ranged::piece`]), and so are
-/// doubted detections (on marsyard seed 7, 98.9 % of their bearing intervals held the
-/// truth, against 99.9 % of those used before); neither founds a landmark, and a doubted one anchors only
-/// where every registered frame that holds the landmark pairs it, as a far rock does
+/// doubted detections (on marsyard seed 7, 98.9 % of their bearing intervals held the truth,
+/// against 99.9 % of those used before); neither founds a landmark, and a doubted one anchors
+/// only where every registered frame that holds the landmark pairs it, as a far rock does
 /// (`association::Evidence::doubtful`). The farther part of a blob separated by
 /// parallax is used though the detector doubts it: the nearer part may hide some of it, which
 /// its bearing (over the nearer part's columns, as a piece's) and its range (its own pixels'
