@@ -271,21 +271,40 @@ pub fn associate<C: Calculus>(
         .map(|e| e.ray)
         .chain(station.unused.iter().copied())
         .collect();
-    let mut registrations = registrations(frames, &placed, &candidates, &seen, lately);
+    // Doubted detections observe: registration fits the others, and pairs them under the
+    // motions found ([`Registration::pair_observers`]).
+    let firm: Vec<Option<Placed>> = evidence
+        .iter()
+        .map(|e| e.placed.filter(|_| !e.doubtful))
+        .collect();
+    let observers: Vec<usize> = (0..n).filter(|&i| evidence[i].doubtful).collect();
+    let mut registrations = registrations(frames, &firm, &candidates, &seen, lately);
     let elsewhere: Vec<Ray> = (0..n)
-        .filter(|&k| placed[k].is_none())
+        .filter(|&k| firm[k].is_none())
         .map(|k| evidence[k].ray)
         .chain(station.unused.iter().copied())
         .collect();
     for (frame, registration) in &mut registrations {
-        registration.drop_pairs_seen_elsewhere(frame, &placed, &elsewhere);
+        registration.drop_pairs_seen_elsewhere(frame, &firm, &elsewhere);
     }
     // The dropped pairs' landmarks may be other rocks, so they no longer support the motion:
     // fewer than the fewest believed left, and the fit is not trusted (the 1 000-rock drive,
     // stations 62–66: 4-pair fits left with 1 or 2 pairs anchored rocks 15–59 m from their
     // landmarks' own).
     registrations.retain(|(_, registration)| registration.pairs.len() >= MIN_INLIERS);
-    let registrations = believed(registrations, frames);
+    let mut registrations = believed(registrations, frames);
+    // Where nothing placed was seen: the directions an observer's landmark must not lie in
+    // (the others' pairs passed this test with the observers' directions too).
+    let unplaced: Vec<Ray> = (0..n)
+        .filter(|&k| placed[k].is_none())
+        .map(|k| evidence[k].ray)
+        .chain(station.unused.iter().copied())
+        .collect();
+    let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
+    for (frame, registration) in &mut registrations {
+        registration.pair_observers(frame, &placed, &observers, &alike);
+        registration.drop_pairs_seen_elsewhere(frame, &placed, &unplaced);
+    }
     let min_support = if station.colour {
         1
     } else {

@@ -278,7 +278,9 @@ impl<C: Calculus> Mapper<C> {
     }
 
     /// The size cue, for landmarks whose width earlier stations bounded (not for parts of a
-    /// blob separated by parallax or pieces: see `selection::width_of`; nor for luminance-mode
+    /// blob separated by parallax, pieces or doubted detections, whose apparent width may be
+    /// part of their rock's: see `selection::width_of`; `sparse-large` seed 3 half, station 38:
+    /// a doubted piece 31.5 m away was put at 25.08 m by it; nor for luminance-mode
     /// detections: the stereo test's window widens every blob by a few columns, far more of
     /// a distant rock's width than of a near one's, beyond the cue's margin).
     fn apply_size_cue(
@@ -290,7 +292,11 @@ impl<C: Calculus> Mapper<C> {
         for s in &associated.fused {
             let i = associated.usable[s.position];
             let d = &station.primary[i];
-            if d.separation != Separation::Whole || d.contact_slack_rows > 0.0 || ranged[i].piece {
+            if d.separation != Separation::Whole
+                || d.contact_slack_rows > 0.0
+                || ranged[i].piece
+                || selection::doubted(d)
+            {
                 continue;
             }
             if let Some(width) = self.gallery.profile(s.landmark).and_then(|p| p.width) {

@@ -85,7 +85,7 @@ pub(crate) fn usable_undoubted(
 /// notch, or beside a nearer piece that may hide some of it; by luminance also a top without
 /// its body). The farther part of a blob separated by parallax is flagged too, but its bearing
 /// and range already allow for what the nearer part may hide.
-fn doubted(d: &Detection) -> bool {
+pub(super) fn doubted(d: &Detection) -> bool {
     d.ambiguous && d.separation != Separation::Farther
 }
 
@@ -128,11 +128,12 @@ pub(crate) fn station_evidence(
 }
 
 /// The physical width a detection implies for its rock (`ranging::width_evidence`), unless it
-/// is a part of a blob separated by parallax or a piece touching another: a false cut of one
-/// large rock (its sides read farther than its middle) leaves a part narrower than the rock,
-/// which would bound the landmark's width too low and put the size cue's ranges too far.
+/// is a part of a blob separated by parallax, a piece touching another, or doubted: a false
+/// cut of one large rock (its sides read farther than its middle) leaves a part narrower than
+/// the rock, which would bound the landmark's width too low and put the size cue's ranges too
+/// far.
 fn width_of(d: &Detection, ranged: &Ranged, model: &SensorModel) -> Option<RangeInterval> {
-    (d.separation == Separation::Whole && !ranged.piece)
+    (d.separation == Separation::Whole && !ranged.piece && !doubted(d))
         .then(|| ranging::width_evidence(ranged, model))
         .flatten()
 }
