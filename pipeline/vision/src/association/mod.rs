@@ -14,7 +14,10 @@
 //!    the direction of a detection mapping does not use is dropped (it may be that rock). An
 //!    anchor must be paired so by most registered frames that hold its landmark; one placed
 //!    looser than 2 m (a far rock) by every one, two at least, where none knows another rock
-//!    it may be ([`Registration::crowded`]). Anchors
+//!    it may be ([`Registration::crowded`]). A detection the detector doubts
+//!    ([`Evidence::doubtful`]) takes no part in the fit: each registration pairs it afterwards
+//!    under its motion ([`Registration::pair_observers`]), and it anchors only as a far rock
+//!    does. Anchors
 //!    are checked against each other: a triple of anchors whose measured states do not
 //!    overlap the map's is inconsistent, and the anchor in most such triples is dropped until
 //!    none is left. Matches are then checked against earlier stations' placements of their
