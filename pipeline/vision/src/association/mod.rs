@@ -276,17 +276,14 @@ pub fn associate<C: Calculus>(
         .collect();
     // Doubted detections observe: registration fits the others, and pairs them under the
     // motions found ([`Registration::pair_observers`]).
+    let doubtful: Vec<bool> = evidence.iter().map(|e| e.doubtful).collect();
     let firm: Vec<Option<Placed>> = evidence
         .iter()
         .map(|e| e.placed.filter(|_| !e.doubtful))
         .collect();
-    let observers: Vec<usize> = (0..n).filter(|&i| evidence[i].doubtful).collect();
+    let observers: Vec<usize> = (0..n).filter(|&i| doubtful[i]).collect();
     let mut registrations = registrations(frames, &firm, &candidates, &seen, lately);
-    let elsewhere: Vec<Ray> = (0..n)
-        .filter(|&k| firm[k].is_none())
-        .map(|k| evidence[k].ray)
-        .chain(station.unused.iter().copied())
-        .collect();
+    let elsewhere = unplaced_rays(station, &firm);
     for (frame, registration) in &mut registrations {
         registration.drop_pairs_seen_elsewhere(frame, &firm, &elsewhere);
     }
@@ -298,12 +295,8 @@ pub fn associate<C: Calculus>(
     let mut registrations = believed(registrations, frames);
     // Where nothing placed was seen: the directions an observer's landmark must not lie in
     // (the others' pairs passed this test with the observers' directions too).
-    let unplaced: Vec<Ray> = (0..n)
-        .filter(|&k| placed[k].is_none())
-        .map(|k| evidence[k].ray)
-        .chain(station.unused.iter().copied())
-        .collect();
-    let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
+    let unplaced = unplaced_rays(station, &placed);
+    let alike = |i: usize, l: LandmarkId| looks_alike(&candidates, i, l);
     for (frame, registration) in &mut registrations {
         registration.pair_observers(frame, &placed, &observers, &alike);
         registration.drop_pairs_seen_elsewhere(frame, &placed, &unplaced);
@@ -313,7 +306,6 @@ pub fn associate<C: Calculus>(
     } else {
         settings.min_support_without_colour
     };
-    let doubtful: Vec<bool> = evidence.iter().map(|e| e.doubtful).collect();
     let mut anchors = anchors(&registrations, &candidates, &placed, &doubtful, min_support);
     let candidates = placed_near(candidates, &registrations, &placed);
     drop_inconsistent_anchors(map, view, &mut anchors);
@@ -388,6 +380,24 @@ fn placed_as(frame: &Frame, registration: &Registration, p: Placed, q: Placed) -
     within(p, q, registration, slack)
 }
 
+/// Whether landmark `l` is among detection `i`'s look-alike candidates.
+fn looks_alike(candidates: &[Vec<(LandmarkId, f64)>], i: usize, l: LandmarkId) -> bool {
+    candidates[i].iter().any(|c| c.0 == l)
+}
+
+/// The rays of the station's detections without a placement in `placements`, and of those
+/// mapping does not use: where it saw something a registration pair's landmark may be.
+fn unplaced_rays(station: &StationEvidence, placements: &[Option<Placed>]) -> Vec<Ray> {
+    station
+        .detections
+        .iter()
+        .zip(placements)
+        .filter(|(_, p)| p.is_none())
+        .map(|(e, _)| e.ray)
+        .chain(station.unused.iter().copied())
+        .collect()
+}
+
 /// The frames the station registers against, with their registrations (see [`register`]).
 fn registrations<'f>(
     frames: &'f [Frame],
@@ -396,7 +406,7 @@ fn registrations<'f>(
     seen: &[Ray],
     lately: &(dyn Fn(LandmarkId) -> bool + Sync),
 ) -> Vec<(&'f Frame, Registration)> {
-    let alike = |i: usize, l: LandmarkId| candidates[i].iter().any(|c| c.0 == l);
+    let alike = |i: usize, l: LandmarkId| looks_alike(candidates, i, l);
     // How far this station places rocks: a landmark the motion brings farther may be beyond
     // detection, so its absence says nothing.
     let reach = placed
