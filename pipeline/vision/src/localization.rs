@@ -22,7 +22,7 @@
 use crate::association::{associate, AssociationSettings, Decision, Frame, Gallery};
 use crate::calib::Calibration;
 use crate::ranging::{self, RangeInterval, SensorModel};
-use crate::run::selection::{placement, station_evidence, usable_undoubted};
+use crate::run::selection::{placement, station_evidence, usable_firm};
 use crate::run::{LandmarkRecord, StationDetections, StationRecord};
 use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
@@ -135,7 +135,7 @@ impl<C: Calculus> KnownMap<C> {
             calib,
             sensor,
         );
-        let usable = usable_undoubted(station, &ranged, calib.image.width);
+        let usable = usable_firm(station, &ranged, calib.image.width);
         let mut identified = Vec::new();
         let mut ambiguous = Vec::new();
         if !usable.is_empty() {

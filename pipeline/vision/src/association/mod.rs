@@ -158,8 +158,9 @@ pub struct Evidence {
     /// part of a rock or hold parts of two, so it observes landmarks but founds none.
     pub piece: bool,
     /// Doubted by the detector (a piece cut at a shallow notch, or beside a nearer piece that
-    /// may hide some of it): it observes landmarks, founds none, and anchors only as a far
-    /// rock does, where every registered frame holding the landmark pairs it.
+    /// may hide some of it), or by luminance a piece, whose placement is looser than its
+    /// interval says: it observes landmarks, steers no registration, founds none, and anchors
+    /// only as a far rock does, where every registered frame holding the landmark pairs it.
     pub doubtful: bool,
     /// Rock pixels of the detection: too few ([`MIN_FOUNDING_PIXELS`]) describe no looks.
     pub pixels: u32,
@@ -224,10 +225,10 @@ pub const MIN_FOUNDING_PIXELS: u32 = 9;
 /// either way, for which 36 later sightings of it and of another rock were held back and given
 /// up; without it, the rock founded a landmark from 3.8 m, matched at 9 later stations).
 pub fn unfounded(evidence: &Evidence) -> Option<Unfounded> {
-    if evidence.doubtful {
-        Some(Unfounded::Doubtful)
-    } else if evidence.piece {
+    if evidence.piece {
         Some(Unfounded::Piece)
+    } else if evidence.doubtful {
+        Some(Unfounded::Doubtful)
     } else if evidence.pixels < MIN_FOUNDING_PIXELS {
         Some(Unfounded::Small)
     } else if evidence

@@ -110,9 +110,10 @@ pub enum Exclusion {
     /// written by runs before such parts were used (stop 35), and kept so that their
     /// `stations.json` still reads.
     Behind,
-    /// The detector doubts it is one whole rock: a piece cut at a shallow notch, a top
-    /// without its body, or no stereo to tell it from a shadow. Left out in luminance mode; in
-    /// colour mode, used but matched to no landmark (a doubted detection founds none).
+    /// The detector doubts it is one whole rock (a piece cut at a shallow notch, a top without
+    /// its body, or no stereo to tell it from a shadow), and it matched no landmark: a doubted
+    /// detection founds none. (Runs before stop 54 left such detections out in luminance
+    /// mode.)
     Doubted,
     /// Matched no landmark and placed too loosely to found one (a far rock whose range
     /// interval spans metres: `association::unfounded`).
@@ -123,8 +124,9 @@ pub enum Exclusion {
     Small,
     /// Taller than wide: a farther rock seen over a nearer one.
     Stacked,
-    /// Its box meets another detection's (two rocks, or one rock in two pieces): left out in
-    /// luminance mode; in colour mode, used but matched to no landmark (a piece founds none).
+    /// A piece, its box meeting another detection's (two rocks, or one rock in two pieces),
+    /// and it matched no landmark: a piece founds none. (Runs before stop 54 left such
+    /// detections out in luminance mode.)
     Touching,
     /// Its bearing interval is too wide to measure with.
     WideBearing,
