@@ -481,28 +481,39 @@ fn unambiguous(
     inliers: &[(usize, usize)],
 ) -> (Motion, Vec<(usize, LandmarkId)>) {
     let motion = Motion::fit(&placed_pairs(current, frame, inliers));
-    let gap =
-        |i: usize, j: usize| motion.separation(&current[i].expect("placed"), &frame.landmarks[j].1);
-    let placed: Vec<usize> = (0..current.len())
-        .filter(|&i| current[i].is_some())
-        .collect();
     let pairs = inliers
         .iter()
         .copied()
-        .filter(|&(i, j)| {
-            let separation = gap(i, j);
-            let d = separation.distance;
-            separation.within()
-                && current[i].expect("placed").reach() <= LONG_ANCHOR_RADIUS_M
-                && (0..frame.landmarks.len())
-                    .all(|k| k == j || gap(i, k).distance > UNIQUE * d + SLACK_M)
-                && placed
-                    .iter()
-                    .all(|&k| k == i || gap(k, j).distance > UNIQUE * d + SLACK_M)
-        })
+        .filter(|&(i, j)| unambiguous_pair(&motion, current, frame, i, j))
         .map(|(i, j)| (i, frame.landmarks[j].0))
         .collect();
     (motion, pairs)
+}
+
+/// Whether landmark `j` of the frame is detection `i`'s unambiguous partner under `motion`:
+/// the detection is placed no looser than registration pairs ([`LONG_ANCHOR_RADIUS_M`]), the
+/// landmark lies within the pair's separation, every other landmark clearly farther from the
+/// detection and every other placed detection clearly farther from the landmark.
+fn unambiguous_pair(
+    motion: &Motion,
+    current: &[Option<Placed>],
+    frame: &Frame,
+    i: usize,
+    j: usize,
+) -> bool {
+    let Some(p) = current[i] else {
+        return false;
+    };
+    let q = frame.landmarks[j].1;
+    let separation = motion.separation(&p, &q);
+    let near = UNIQUE * separation.distance + SLACK_M;
+    separation.within()
+        && p.reach() <= LONG_ANCHOR_RADIUS_M
+        && (0..frame.landmarks.len())
+            .all(|k| k == j || motion.separation(&p, &frame.landmarks[k].1).distance > near)
+        && current.iter().enumerate().all(|(k, other)| {
+            k == i || other.is_none_or(|o| motion.separation(&o, &q).distance > near)
+        })
 }
 
 impl Registration {
@@ -523,33 +534,24 @@ impl Registration {
         alike: &dyn Fn(usize, LandmarkId) -> bool,
     ) {
         let motion = self.motion();
-        let gap = |p: &Placed, q: &Placed| motion.separation(p, q).distance;
         let mut added = Vec::new();
         for &i in observers {
-            let Some(p) = placed[i].filter(|p| p.reach() <= LONG_ANCHOR_RADIUS_M) else {
+            let Some(p) = placed[i] else {
                 continue;
             };
             let nearest = frame
                 .landmarks
                 .iter()
                 .enumerate()
-                .map(|(j, (_, q))| (j, motion.separation(&p, q)))
-                .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance));
-            let Some((j, separation)) = nearest.filter(|(_, s)| s.within()) else {
+                .map(|(j, (_, q))| (j, motion.separation(&p, q).distance))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map(|(j, _)| j);
+            let Some(j) = nearest.filter(|&j| unambiguous_pair(&motion, placed, frame, i, j))
+            else {
                 continue;
             };
-            let (l, q) = frame.landmarks[j];
-            let near = UNIQUE * separation.distance + SLACK_M;
-            let clear = frame
-                .landmarks
-                .iter()
-                .enumerate()
-                .all(|(k, (_, r))| k == j || gap(&p, r) > near)
-                && placed
-                    .iter()
-                    .enumerate()
-                    .all(|(k, other)| k == i || other.is_none_or(|o| gap(&o, &q) > near));
-            if clear && alike(i, l) && !self.pairs.iter().any(|&(_, m)| m == l) {
+            let l = frame.landmarks[j].0;
+            if alike(i, l) && !self.pairs.iter().any(|&(_, m)| m == l) {
                 added.push((i, l));
             }
         }
