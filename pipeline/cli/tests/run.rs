@@ -106,6 +106,12 @@ fn maps_the_demo_dataset_soundly() {
             .unwrap_or_else(|| panic!("{path:?} in {eval}"))
     };
     assert_eq!(score(&["range", "wrong_pairs"]), 0.0, "{eval}");
+    assert_eq!(score(&["range", "fused_wrong_pairs"]), 0.0, "{eval}");
+    assert!(score(&["range", "fused_asserted_pairs"]) > 0.0, "{eval}");
+    assert!(
+        score(&["bearing_fused", "within_interval"]) >= 0.95,
+        "{eval}"
+    );
     assert_eq!(score(&["map", "run", "unsound_relations"]), 0.0, "{eval}");
     assert_eq!(score(&["map", "exact", "unsound_relations"]), 0.0, "{eval}");
     assert!(

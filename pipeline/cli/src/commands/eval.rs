@@ -188,9 +188,18 @@ pub fn print_report(e: &Evaluation) {
         "  detection: precision {:.3} ({} of {}), recall {:.3} ({} of {} detectable) over {} images",
         d.precision, d.true_detections, d.detections, d.recall, d.detectable_found, d.detectable, d.images
     );
-    for (name, b) in [("all", &e.bearing), ("used", &e.bearing_used)] {
+    for (name, b) in [
+        ("all", &e.bearing),
+        ("used", &e.bearing_used),
+        ("fused", &e.bearing_fused),
+        ("fused pieces", &e.bearing_pieces),
+    ] {
+        if b.count == 0 {
+            println!("  bearing error ({name}): none");
+            continue;
+        }
         println!(
-            "  bearing error ({name:<4}): {} bearings, median {:.3}°, worst {:.3}°; inside its interval {:.1} % (worst error/interval {:.2})",
+            "  bearing error ({name}): {} bearings, median {:.3}°, worst {:.3}°; inside its interval {:.1} % (worst error/interval {:.2})",
             b.count,
             b.median_error_deg,
             b.worst_error_deg,
@@ -213,8 +222,8 @@ pub fn print_report(e: &Evaluation) {
         );
     }
     println!(
-        "  range order: {} of the {} pairs of detections matched to rocks asserted, {} wrong; {} cue conflicts",
-        r.asserted_pairs, r.pairs, r.wrong_pairs, r.conflicts
+        "  range order: {} of the {} pairs of detections matched to rocks asserted, {} wrong ({} asserted between sightings that reached the map, {} wrong); {} cue conflicts",
+        r.asserted_pairs, r.pairs, r.wrong_pairs, r.fused_asserted_pairs, r.fused_wrong_pairs, r.conflicts
     );
     println!(
         "  of all {} asserted pairs (matched to rocks or not), separated by ground alone {}, stereo alone {}, size alone {}, only by the fusion {}",

@@ -18,7 +18,7 @@ use qrm_core::probabilistic::map::{compare, BeliefComparison, BeliefMap};
 use qrm_vision::calib::Calibration;
 use qrm_vision::run::{LandmarkRecord, StationRecord};
 use serde::Serialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Evaluation {
@@ -27,6 +27,11 @@ pub struct Evaluation {
     /// aside detections it doubts: possibly several rocks, slivers, pieces touching others).
     pub bearing: BearingScore,
     pub bearing_used: BearingScore,
+    /// Bearings of the sightings that reached the map, which its soundness rests on (`used`
+    /// also counts detections held back and given up), and of those that are pieces of their
+    /// rock, holding under 30 % of its visible pixels.
+    pub bearing_fused: BearingScore,
+    pub bearing_pieces: BearingScore,
     pub range: RangeScore,
     pub association: AssociationScore,
     /// The rock each landmark stands for: the one most of its sightings show (landmarks made
@@ -83,6 +88,13 @@ pub struct RangeScore {
     pub pairs: usize,
     pub asserted_pairs: usize,
     pub wrong_pairs: usize,
+    /// Of those, the asserted pairs between two sightings that reached the map, and the wrong
+    /// ones among them: the pairs the map's soundness rests on.
+    pub fused_asserted_pairs: usize,
+    pub fused_wrong_pairs: usize,
+    /// Each wrong one as `(station, detection asserted nearer, detection asserted farther)`
+    /// (indices into `stations.json`): where to look.
+    pub fused_wrong: Vec<(usize, usize, usize)>,
     /// All asserted pairs (matched to truth or not), those each cue separates on its own, and
     /// those only the fused intervals separate.
     pub asserted_all: usize,
@@ -277,17 +289,24 @@ pub fn score_run(
     calib: &Calibration,
     detectable: Detectable,
 ) -> Evaluation {
+    let fused: HashSet<(usize, usize)> = run
+        .landmarks
+        .iter()
+        .flat_map(|l| l.sightings.iter().copied())
+        .collect();
     let mut tally = front_end::Tally::default();
     for (record, image) in eval_records(run.records, truth) {
-        tally.add_image(record, image, truth, calib, detectable);
+        tally.add_image(record, image, truth, calib, detectable, &fused);
     }
-    let (detection, bearing, bearing_used, range) = tally.scores();
+    let scores = tally.scores();
     let (association, rocks) = association::score(run.landmarks, &tally.matched);
     Evaluation {
-        detection,
-        bearing,
-        bearing_used,
-        range,
+        detection: scores.detection,
+        bearing: scores.bearing,
+        bearing_used: scores.bearing_used,
+        bearing_fused: scores.bearing_fused,
+        bearing_pieces: scores.bearing_pieces,
+        range: scores.range,
         association,
         landmark_rocks: rocks.all(),
         map: map::score(run, truth, &rocks),
