@@ -13,6 +13,7 @@
 
 mod components;
 mod extent;
+mod faint;
 mod ground;
 mod parallax;
 mod split;
@@ -376,9 +377,19 @@ fn detect_in(
         })
         .collect();
     // In colour mode, how far each detected blob's rock may reach beyond what the colour test
-    // found.
+    // found: by stereo, and by faint colour.
     if let Some(bands) = ground_bands.filter(|_| !luminance) {
         reach_beyond(&mut detections, &blobs, mask.as_slice(), bands);
+    }
+    // (Only for the primary panorama: a right one's detections serve the stereo cue alone.)
+    if !luminance && !matches!(other, Some((_, Eye::Left))) {
+        let searched = detected_blobs(&detections);
+        let components: Vec<&components::Component> =
+            searched.iter().map(|&b| &blobs[b as usize]).collect();
+        let reach = faint::reach(&components, mask.as_slice(), raw, w, settings);
+        let reach: std::collections::HashMap<u32, [u32; 2]> =
+            searched.into_iter().zip(reach).collect();
+        widen_beyond(&mut detections, &blobs, |blob| reach[&blob]);
     }
     detections.sort_by(|a, b| a.centroid[0].total_cmp(&b.centroid[0]));
     detections
@@ -411,10 +422,7 @@ fn reach_beyond(
             r < rows && test.stance(c.rem_euclid(w as i64) as usize, r) == ground::Stance::Raised
         })
     };
-    let mut searched: Vec<u32> = detections.iter().map(|d| d.blob).collect();
-    searched.sort_unstable();
-    searched.dedup();
-    let reach: std::collections::HashMap<u32, [u32; 2]> = searched
+    let reach: std::collections::HashMap<u32, [u32; 2]> = detected_blobs(detections)
         .into_par_iter()
         .filter_map(|blob| {
             let pixels = &blobs[blob as usize];
@@ -425,17 +433,38 @@ fn reach_beyond(
             ))
         })
         .collect();
+    widen_beyond(detections, blobs, |blob| {
+        reach.get(&blob).copied().unwrap_or_default()
+    });
+}
+
+/// The blobs (indices into the mask's components) that some detection was cut from, once each.
+fn detected_blobs(detections: &[Detection]) -> Vec<u32> {
+    let mut blobs: Vec<u32> = detections.iter().map(|d| d.blob).collect();
+    blobs.sort_unstable();
+    blobs.dedup();
+    blobs
+}
+
+/// Widens each detection's [`Detection::beyond_columns`] to the columns its blob's rock may
+/// reach (`reach` of its blob), on the sides where it ends the blob.
+fn widen_beyond(
+    detections: &mut [Detection],
+    blobs: &[components::Component],
+    reach: impl Fn(u32) -> [u32; 2],
+) {
     for detection in detections {
-        let (Some(&[before, after]), Some(b)) = (
-            reach.get(&detection.blob),
-            bounds(&blobs[detection.blob as usize]),
-        ) else {
+        let Some(b) = bounds(&blobs[detection.blob as usize]) else {
             continue;
         };
-        detection.beyond_columns = [
-            if detection.bbox[0] == b[0] { before } else { 0 },
-            if detection.bbox[2] == b[2] { after } else { 0 },
-        ];
+        let [before, after] = reach(detection.blob);
+        let beyond = &mut detection.beyond_columns;
+        if detection.bbox[0] == b[0] {
+            beyond[0] = beyond[0].max(before);
+        }
+        if detection.bbox[2] == b[2] {
+            beyond[1] = beyond[1].max(after);
+        }
     }
 }
 
