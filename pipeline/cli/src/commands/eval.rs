@@ -182,17 +182,18 @@ pub fn score_run_files(
 }
 
 pub fn print_report(e: &Evaluation) {
-    let d = &e.detection;
+    let f = &e.front_end;
+    let d = &f.detection;
     println!("evaluation against truth:");
     println!(
         "  detection: precision {:.3} ({} of {}), recall {:.3} ({} of {} detectable) over {} images",
         d.precision, d.true_detections, d.detections, d.recall, d.detectable_found, d.detectable, d.images
     );
     for (name, b) in [
-        ("all", &e.bearing),
-        ("used", &e.bearing_used),
-        ("fused", &e.bearing_fused),
-        ("fused pieces", &e.bearing_pieces),
+        ("all", &f.bearing),
+        ("used", &f.bearing_used),
+        ("fused", &f.bearing_fused),
+        ("fused pieces", &f.bearing_pieces),
     ] {
         if b.count == 0 {
             println!("  bearing error ({name}): none");
@@ -207,7 +208,7 @@ pub fn print_report(e: &Evaluation) {
             b.worst_error_ratio
         );
     }
-    let r = &e.range;
+    let r = &f.range;
     for (name, c) in [
         ("ground", &r.ground),
         ("stereo", &r.stereo),

@@ -2,7 +2,7 @@
 //! the asserted range order, against the truth rock each detection is credited with.
 
 use super::detection::{ratio, Detectable, DetectedBox, Score};
-use super::{BearingScore, CueScore, DetectionScore, RangeScore};
+use super::{BearingScore, CueScore, DetectionScore, FrontEndScore, RangeScore};
 use crate::dataset::{ImageTruth, Truth};
 use qrm_core::measurement::angular_distance;
 use qrm_vision::calib::Calibration;
@@ -15,31 +15,19 @@ use std::f64::consts::TAU;
 /// the fused bearings that missed their rocks).
 pub(super) const PIECE_SHARE: f64 = 0.3;
 
-/// The front end's figures, by group of detections.
-pub(super) struct FrontEndScores {
-    pub detection: DetectionScore,
-    pub bearing: BearingScore,
-    pub bearing_used: BearingScore,
-    pub bearing_fused: BearingScore,
-    pub bearing_pieces: BearingScore,
-    pub range: RangeScore,
-}
-
 /// The front end's figures, summed over images.
 #[derive(Default)]
 pub(super) struct Tally {
     detection: Score,
     /// Truth rock of every matched `(station index, detection index)`.
     pub matched: HashMap<(usize, usize), u32>,
-    /// Bearing error of every matched detection; and error with interval half-width of the
-    /// detections the run used, of the sightings that reached the map, and of those of the
-    /// latter that are pieces of their rock ([`PIECE_SHARE`]).
-    bearing_errors: Vec<f64>,
+    /// Bearing error with interval half-width of every matched detection, of the detections
+    /// the run used, of the sightings that reached the map, and of those of the latter that
+    /// are pieces of their rock ([`PIECE_SHARE`]).
+    bearing_errors: Vec<(f64, f64)>,
     used_errors: Vec<(f64, f64)>,
     fused_errors: Vec<(f64, f64)>,
     piece_errors: Vec<(f64, f64)>,
-    within: usize,
-    worst_ratio: f64,
     /// Per cue (ground, stereo, size, fused): whether the interval held the true range, and
     /// its width relative to it.
     cue_checks: [Vec<(bool, f64)>; 4],
@@ -99,15 +87,9 @@ impl Tally {
     /// Adds a detection's bearing against the truth; its error.
     fn add_bearing(&mut self, d: &DetectionRecord, truth: f64) -> f64 {
         let error = angular_distance(d.bearing, truth);
-        self.bearing_errors.push(error);
+        self.bearing_errors.push((error, d.bearing_uncertainty));
         if !matches!(d.association, Association::Unused { .. }) {
             self.used_errors.push((error, d.bearing_uncertainty));
-        }
-        if error <= d.bearing_uncertainty {
-            self.within += 1;
-        }
-        if d.bearing_uncertainty > 0.0 {
-            self.worst_ratio = self.worst_ratio.max(error / d.bearing_uncertainty);
         }
         error
     }
@@ -164,7 +146,7 @@ impl Tally {
     }
 
     /// Detection, bearing (all matched, used, fused, fused pieces), and range figures.
-    pub fn scores(&self) -> FrontEndScores {
+    pub fn scores(&self) -> FrontEndScore {
         let d = &self.detection;
         let detection = DetectionScore {
             images: d.images,
@@ -174,18 +156,6 @@ impl Tally {
             detectable_found: d.found,
             precision: d.precision(),
             recall: d.recall(),
-        };
-        let all = BearingScore {
-            count: self.bearing_errors.len(),
-            median_error_deg: median(self.bearing_errors.clone()).to_degrees(),
-            worst_error_deg: self
-                .bearing_errors
-                .iter()
-                .copied()
-                .fold(0.0, f64::max)
-                .to_degrees(),
-            within_interval: ratio(self.within, self.bearing_errors.len()),
-            worst_error_ratio: self.worst_ratio,
         };
         let cue = |checks: &Vec<(bool, f64)>| CueScore {
             count: checks.len(),
@@ -205,9 +175,9 @@ impl Tally {
             fused: cue(&self.cue_checks[3]),
             ..self.range.clone()
         };
-        FrontEndScores {
+        FrontEndScore {
             detection,
-            bearing: all,
+            bearing: bearing_score(&self.bearing_errors),
             bearing_used: bearing_score(&self.used_errors),
             bearing_fused: bearing_score(&self.fused_errors),
             bearing_pieces: bearing_score(&self.piece_errors),

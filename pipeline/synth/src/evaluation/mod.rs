@@ -22,6 +22,22 @@ use std::collections::{BTreeMap, HashSet};
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Evaluation {
+    #[serde(flatten)]
+    pub front_end: FrontEndScore,
+    pub association: AssociationScore,
+    /// The rock each landmark stands for: the one most of its sightings show (landmarks made
+    /// only of false detections have none).
+    pub landmark_rocks: BTreeMap<LandmarkId, u32>,
+    pub map: MapScore,
+    /// `--mode probabilistic`: 002's beliefs and the map's sets against the truth, over the
+    /// triples with a belief, each landmark held to its majority rock.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub beliefs: Option<BeliefComparison>,
+}
+
+/// The front end's figures: detection, bearings and range cues and order, image by image.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct FrontEndScore {
     pub detection: DetectionScore,
     /// Bearings of every detection matched to a rock, and of those the run used (it sets
     /// aside detections it doubts: possibly several rocks, slivers, pieces touching others).
@@ -33,15 +49,6 @@ pub struct Evaluation {
     pub bearing_fused: BearingScore,
     pub bearing_pieces: BearingScore,
     pub range: RangeScore,
-    pub association: AssociationScore,
-    /// The rock each landmark stands for: the one most of its sightings show (landmarks made
-    /// only of false detections have none).
-    pub landmark_rocks: BTreeMap<LandmarkId, u32>,
-    pub map: MapScore,
-    /// `--mode probabilistic`: 002's beliefs and the map's sets against the truth, over the
-    /// triples with a belief, each landmark held to its majority rock.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub beliefs: Option<BeliefComparison>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -298,15 +305,9 @@ pub fn score_run(
     for (record, image) in eval_records(run.records, truth) {
         tally.add_image(record, image, truth, calib, detectable, &fused);
     }
-    let scores = tally.scores();
     let (association, rocks) = association::score(run.landmarks, &tally.matched);
     Evaluation {
-        detection: scores.detection,
-        bearing: scores.bearing,
-        bearing_used: scores.bearing_used,
-        bearing_fused: scores.bearing_fused,
-        bearing_pieces: scores.bearing_pieces,
-        range: scores.range,
+        front_end: tally.scores(),
         association,
         landmark_rocks: rocks.all(),
         map: map::score(run, truth, &rocks),
