@@ -115,6 +115,19 @@ fn band_costs(bands: &Bands) -> Costs {
 pub(super) struct GroundTest<'a> {
     tiles: Tiles<'a>,
     threshold: f32,
+    /// Both bands smoothed around each tile, for matching at shifts up to [`FACE_SHIFTS`]
+    /// ([`GroundTest::nearer`]); made when a tile is first asked.
+    faces: Vec<OnceLock<FacePlanes>>,
+    /// The largest shift [`GroundTest::nearer`] tries: the nearest face any blob of the band
+    /// may show ([`nearest_face_shift`] at the band's bottom).
+    face_shifts: usize,
+}
+
+/// A tile's neighbourhood in both bands, smoothed, for [`GroundTest::nearer`]: the tested
+/// panorama's around the tile, its partner's as far along as the largest shift.
+struct FacePlanes {
+    own: Plane,
+    other: Plane,
 }
 
 impl<'a> GroundTest<'a> {
@@ -127,10 +140,80 @@ impl<'a> GroundTest<'a> {
             .step_by(SAMPLE_STRIDE)
             .flat_map_iter(|t| tiles.costs(t).cost.clone())
             .collect();
+        let faces = (0..tiles.costs.len()).map(|_| OnceLock::new()).collect();
+        let face_shifts = nearest_face_shift(bands.calib, (bands.top + bands.rows()) as f64, true);
         GroundTest {
             tiles,
             threshold: texture_threshold(sampled),
+            faces,
+            face_shifts,
         }
+    }
+
+    /// Whether the pixel at `column` and `row`, too smooth for [`GroundTest::stance`], stands
+    /// nearer than the ground: its neighbourhood mismatches the other panorama at the ground's
+    /// shift by more than the texture threshold, and matches it best at a shift from
+    /// [`SELF_SHIFT`] beyond the ground's up to `max_shift` columns (the nearest face the blob
+    /// searched from may show; a nearer rock's face matches best farther along), at under
+    /// [`MISMATCH_RATIO`] of that cost. A rock's smooth face between its textured edges is
+    /// such a pixel (its shading still tells one shift from another; stress s16: a rock
+    /// nearly the soil's colour whose face the texture test leaves unknown); smooth soil
+    /// matches best at the ground's shift, and its cost there is the images' noise.
+    pub(super) fn nearer(&self, column: usize, row: usize, max_shift: usize) -> bool {
+        let t = row / TILE_ROWS * self.tiles.across + column / TILE_COLUMNS;
+        let (x0, y0) = self.tiles.corner(t);
+        let tile_width = TILE_COLUMNS.min(self.tiles.bands.width - x0);
+        let costs = self.tiles.costs(t);
+        let i = (row - y0) * tile_width + column - x0;
+        let (ground, texture) = (costs.cost[i], costs.texture[i]);
+        if texture > self.threshold || ground <= self.threshold {
+            return false;
+        }
+        let bands = &self.tiles.bands;
+        let planes = self.faces[t].get_or_init(|| {
+            let rows = y0..(y0 + TILE_ROWS).min(bands.rows());
+            let read = rows.start.saturating_sub(RADIUS)..(rows.end + RADIUS).min(bands.rows());
+            let (r, x1) = (RADIUS as isize, (x0 + tile_width) as isize);
+            let reach = bands.direction * self.face_shifts as isize;
+            let (low, high) = (reach.min(0), reach.max(0));
+            FacePlanes {
+                own: smooth_region(
+                    bands.own,
+                    bands.width,
+                    read.clone(),
+                    x0 as isize - r..x1 + r,
+                ),
+                other: smooth_region(
+                    bands.other,
+                    bands.width,
+                    read,
+                    x0 as isize - r + low..x1 + r + high,
+                ),
+            }
+        });
+        let window = row.saturating_sub(RADIUS)..(row + RADIUS + 1).min(bands.rows());
+        let area = (window.len() * (2 * RADIUS + 1)) as f32;
+        let x = column as isize - RADIUS as isize;
+        let n = 2 * RADIUS + 1;
+        let cost_at = |shift: isize| {
+            let sum: f32 = window
+                .clone()
+                .map(|y| {
+                    let a = planes.own.run(y, x, n);
+                    let b = planes.other.run(y, x + bands.direction * shift, n);
+                    a.iter().zip(b).map(|(p, q)| (p - q).abs()).sum::<f32>()
+                })
+                .sum();
+            sum / area
+        };
+        let from =
+            ground_shift(bands.calib, (bands.top + row) as f64 + 0.5).ceil() as isize + SELF_SHIFT;
+        let best = (from..=self.face_shifts as isize)
+            .map(|shift| (cost_at(shift), shift))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        best.is_some_and(|(cost, shift)| {
+            cost < MISMATCH_RATIO * ground && shift <= max_shift as isize
+        })
     }
 
     /// The stance of the pixel at `column` and `row` of the band.
@@ -378,6 +461,18 @@ pub(super) fn contact_doubt(calib: &Calibration) -> f64 {
     RADIUS as f64 + (TOLERANCE_COLUMNS / per_row).ceil()
 }
 
+/// The largest stereo shift (columns) of a rock whose lowest pixel row ends at image row
+/// `bottom`: the shift of a rock somewhat nearer than that row reads on flat ground (a rock's
+/// face overhangs its foot), nearer still when `cut` (the image's bottom hides its foot),
+/// never nearer than 0.5 m.
+pub(super) fn nearest_face_shift(calib: &Calibration, bottom: f64, cut: bool) -> usize {
+    let margin = if cut { 0.5 } else { 0.8 };
+    calib.ground_range(bottom).map_or(0, |range| {
+        (calib.stereo_disparity((margin * range).max(0.5)) / calib.column_width()).ceil() as usize
+            + 3
+    })
+}
+
 /// The flat ground's stereo shift (columns) at image row `row`; 0 at and above the horizon.
 fn ground_shift(calib: &Calibration, row: f64) -> f64 {
     calib.ground_range(row).map_or(0.0, |range| {
@@ -498,6 +593,63 @@ mod tests {
         let (a, b) = (scene.shadow.1.start, scene.shadow.1.end);
         assert!(share(shaded.clone(), a - 2..a + 2, Stance::Ground) > 0.9);
         assert!(share(shaded, b - 2..b + 2, Stance::Ground) > 0.9);
+    }
+
+    #[test]
+    fn a_smooth_face_matches_best_nearer_than_the_ground() {
+        let calib = calib();
+        let (top, w) = (76, 1024);
+        let rows = 192 - top;
+        // A face standing at its foot's range (band row 110), a gentle ramp of 2.5 levels a
+        // column: too smooth for the texture test. The ground is level and smooth.
+        let (face_rows, face_columns) = (20..110, 300i64..400);
+        let face_shift = ground_shift(&calib, (top + face_rows.end) as f64);
+        let band = |direction: f64| -> Vec<u16> {
+            let mut out = vec![300u16; w * rows];
+            for y in face_rows.clone() {
+                for x in 0..w {
+                    let face = x as f64 - direction * face_shift;
+                    if face_columns.contains(&(face.round() as i64)) {
+                        out[y * w + x] = (150.0 + 2.5 * (face - 300.0)) as u16;
+                    }
+                }
+            }
+            out
+        };
+        let (left, right) = (band(0.0), band(-1.0));
+        let test = GroundTest::new(Bands {
+            own: &left,
+            other: &right,
+            width: w,
+            top,
+            calib: &calib,
+            direction: -1,
+        });
+        let share = |rows: Range<usize>, columns: Range<usize>, max_shift: usize| {
+            let pixels: Vec<(usize, usize)> = rows
+                .flat_map(|y| columns.clone().map(move |x| (x, y)))
+                .collect();
+            let unknown = pixels
+                .iter()
+                .filter(|&&(x, y)| test.stance(x, y) == Stance::Unknown)
+                .count();
+            let nearer = pixels
+                .iter()
+                .filter(|&&(x, y)| test.nearer(x, y, max_shift))
+                .count();
+            let n = pixels.len() as f64;
+            (unknown as f64 / n, nearer as f64 / n)
+        };
+        // The face's upper rows lie several columns off the ground's shift: the texture test
+        // cannot tell them, the best shift can.
+        let reach = face_shift.ceil() as usize + 3;
+        let (unknown, nearer) = share(20..60, 310..390, reach);
+        assert!(unknown > 0.9, "{unknown}");
+        assert!(nearer > 0.9, "{nearer}");
+        // Smooth ground is never nearer.
+        assert_eq!(share(20..110, 500..900, reach).1, 0.0);
+        // A blob whose nearest face lies farther does not take this face for its own.
+        assert_eq!(share(20..60, 310..390, reach / 2).1, 0.0);
     }
 
     /// kornia's `gaussian_blur` of the band padded by wrapping at the seam: the reference

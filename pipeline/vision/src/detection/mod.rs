@@ -395,10 +395,11 @@ fn detect_in(
     detections
 }
 
-/// Sets each detection's [`Detection::beyond_columns`]: the raised pixels joining its blob
-/// (`blobs`, components of the colour test's `mask`, as wide as the bands) beside it, on the sides where
-/// it ends the blob. The stereo test of `bands` runs over the tiles the searches visit only;
-/// blobs are searched in parallel.
+/// Sets each detection's [`Detection::beyond_columns`]: the pixels standing up from the
+/// ground (`ground::GroundTest`: raised, or a smooth face nearer than the ground) that join
+/// its blob (`blobs`, components of the colour test's `mask`, as wide as the bands) beside
+/// it, on the sides where it ends the blob. The stereo test of `bands` runs over the tiles
+/// the searches visit only; blobs are searched in parallel.
 fn reach_beyond(
     detections: &mut [Detection],
     blobs: &[components::Component],
@@ -417,9 +418,12 @@ fn reach_beyond(
             REACH_HEIGHTS * (b[3] - b[1] + 1),
         )
     };
-    let raised = |c: i64, r: i64| {
+    // Standing up from the ground: textured and off the ground's shift, or smooth and
+    // matching best nearer than the ground but not nearer than the blob's own rock may be.
+    let stands = |c: i64, r: i64, shift: usize| {
         usize::try_from(r).is_ok_and(|r| {
-            r < rows && test.stance(c.rem_euclid(w as i64) as usize, r) == ground::Stance::Raised
+            let c = c.rem_euclid(w as i64) as usize;
+            r < rows && (test.stance(c, r) == ground::Stance::Raised || test.nearer(c, r, shift))
         })
     };
     let reach: std::collections::HashMap<u32, [u32; 2]> = detected_blobs(detections)
@@ -427,9 +431,11 @@ fn reach_beyond(
         .filter_map(|blob| {
             let pixels = &blobs[blob as usize];
             let b = bounds(pixels)?;
+            let shift = max_shift(pixels, bands.top, rows, bands.calib);
+            let stands = |c, r| stands(c, r, shift);
             Some((
                 blob,
-                extent::beyond(pixels, mask, w, rows, limits(b), raised),
+                extent::beyond(pixels, mask, w, rows, limits(b), stands),
             ))
         })
         .collect();
@@ -533,13 +539,7 @@ fn max_shift(
     calib: &Calibration,
 ) -> usize {
     let bottom = pixels.iter().map(|p| p.1 as usize).max().unwrap_or(0);
-    let margin = if bottom + 1 >= rows { 0.5 } else { 0.8 };
-    let nearest = calib
-        .ground_range((bottom + top + 1) as f64)
-        .map(|r| (margin * r).max(0.5));
-    nearest.map_or(0, |range| {
-        (calib.stereo_disparity(range) / calib.column_width()).ceil() as usize + 3
-    })
+    ground::nearest_face_shift(calib, (bottom + top + 1) as f64, bottom + 1 >= rows)
 }
 
 /// The pieces of one parallax layer: touching rocks cut at notches of the bottom edge. A
