@@ -37,7 +37,7 @@ pub(super) fn beyond(
         first - limit..=last + limit,
         (top - i64::from(rise)).max(0)..=(bottom + 1).min(rows as i64 - 1),
     );
-    // Pixels reached, over the searched rows and columns (wrapped when the columns go round
+    // Pixels tested, over the searched rows and columns (wrapped when the columns go round
     // the panorama).
     let span = (columns.end() - columns.start() + 1).min(w as i64);
     let mut seen = vec![false; span as usize * (row_range.end() - row_range.start() + 1) as usize];
@@ -54,10 +54,14 @@ pub(super) fn beyond(
             let i = nr as usize * w + nc.rem_euclid(w as i64) as usize;
             let slot = ((nr - row_range.start()) * span + (nc - columns.start()).rem_euclid(span))
                 as usize;
-            if mask[i] != 0 || seen[slot] || !raised(nc, nr) {
+            // Each pixel is tested once: the stereo verdict may cost a search over shifts.
+            if mask[i] != 0 || seen[slot] {
                 continue;
             }
             seen[slot] = true;
+            if !raised(nc, nr) {
+                continue;
+            }
             low = low.min(nc);
             high = high.max(nc);
             stack.push((nc, nr));

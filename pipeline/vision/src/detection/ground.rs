@@ -195,24 +195,30 @@ impl<'a> GroundTest<'a> {
         let area = (window.len() * (2 * RADIUS + 1)) as f32;
         let x = column as isize - RADIUS as isize;
         let n = 2 * RADIUS + 1;
-        let cost_at = |shift: isize| {
-            let sum: f32 = window
-                .clone()
-                .map(|y| {
-                    let a = planes.own.run(y, x, n);
-                    let b = planes.other.run(y, x + bands.direction * shift, n);
-                    a.iter().zip(b).map(|(p, q)| (p - q).abs()).sum::<f32>()
-                })
-                .sum();
-            sum / area
+        // The cost at `shift` if under `bound`: a row at a time, given up once the sum reaches
+        // the bound (it only grows), which most shifts do within a row or two.
+        let cost_under = |shift: isize, bound: f32| {
+            let mut sum = 0f32;
+            for y in window.clone() {
+                let a = planes.own.run(y, x, n);
+                let b = planes.other.run(y, x + bands.direction * shift, n);
+                sum += a.iter().zip(b).map(|(p, q)| (p - q).abs()).sum::<f32>();
+                if sum / area >= bound {
+                    return None;
+                }
+            }
+            Some(sum / area)
         };
         let from =
             ground_shift(bands.calib, (bands.top + row) as f64 + 0.5).ceil() as isize + SELF_SHIFT;
-        let best = (from..=self.face_shifts as isize)
-            .map(|shift| (cost_at(shift), shift))
-            .min_by(|a, b| a.0.total_cmp(&b.0));
-        best.is_some_and(|(cost, shift)| {
-            cost < MISMATCH_RATIO * ground && shift <= max_shift as isize
+        // The best match within the blob's shifts, under the mismatch ratio of the ground's …
+        let last = max_shift.min(self.face_shifts) as isize;
+        let best = (from..=last).fold(None, |best, shift| {
+            cost_under(shift, best.unwrap_or(MISMATCH_RATIO * ground)).or(best)
+        });
+        // … and none better beyond them.
+        best.is_some_and(|best| {
+            (last + 1..=self.face_shifts as isize).all(|shift| cost_under(shift, best).is_none())
         })
     }
 
