@@ -57,6 +57,26 @@ pub struct Sighted {
     pub frame: Frame,
 }
 
+impl Sighted {
+    /// Adds a landmark founded after the station was mapped, from one of its held-back
+    /// detections seen along `bearing` and placed at `placed`: the frame holds it where the
+    /// station placed it, and no longer counts that placement among the rocks it left
+    /// unmapped. Without it no registration could pair a later sighting with the landmark,
+    /// and every later sighting of its rock, the landmark a look-alike the map cannot reject,
+    /// would be held back for it and given up (marsyard s7 at stop 56: a near rock seen
+    /// from 9 stations, fused once).
+    fn found_late(&mut self, landmark: LandmarkId, bearing: Bearing, placed: Option<Placed>) {
+        self.bearings.insert(landmark, bearing);
+        let Some(placed) = placed else {
+            return;
+        };
+        self.frame.landmarks.push((landmark, placed));
+        if let Some(k) = self.frame.unmapped.iter().position(|&u| u == placed) {
+            self.frame.unmapped.remove(k);
+        }
+    }
+}
+
 /// An observation whose association stayed ambiguous, kept to be fused later.
 #[derive(Clone, Debug, PartialEq)]
 struct HeldBack {
@@ -627,6 +647,15 @@ impl<C: Calculus> Mapper<C> {
                     self.sightings
                         .push((item.station, item.primary_index, landmark));
                     self.last_seen.record(landmark, item.station);
+                    if let Some(sighted) =
+                        self.sighted.iter_mut().find(|s| s.station == item.station)
+                    {
+                        sighted.found_late(
+                            landmark,
+                            item.view.bearings[item.detection],
+                            item.evidence.placed,
+                        );
+                    }
                     resolved += 1;
                     // The station's other held observations now have this detection's
                     // landmark as a partner to measure with.
@@ -855,6 +884,32 @@ mod tests {
                 .collect(),
             frame: seen.frame(label),
         });
+    }
+
+    #[test]
+    fn a_landmark_founded_late_joins_its_stations_frame() {
+        let placed = |x: f64| Placed::disc([x, 0.0], 0.5);
+        let mut sighted = Sighted {
+            station: 2,
+            bearings: BTreeMap::new(),
+            frame: Frame {
+                landmarks: vec![(0, placed(1.0))],
+                unmapped: vec![placed(2.0), placed(3.0)],
+                accumulated: false,
+                departed: Vec::new(),
+            },
+        };
+        sighted.found_late(7, Bearing::exact(0.5), Some(placed(3.0)));
+        assert_eq!(
+            sighted.frame.landmarks,
+            vec![(0, placed(1.0)), (7, placed(3.0))]
+        );
+        assert_eq!(sighted.frame.unmapped, vec![placed(2.0)]);
+        assert_eq!(sighted.bearings.get(&7), Some(&Bearing::exact(0.5)));
+        // Unplaced, it is only a bearing.
+        sighted.found_late(8, Bearing::exact(1.0), None);
+        assert_eq!(sighted.frame.landmarks.len(), 2);
+        assert_eq!(sighted.bearings.len(), 2);
     }
 
     /// The test drive fused through a mapper with rock `B` taken for landmark `A` at station
