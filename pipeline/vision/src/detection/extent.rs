@@ -8,11 +8,11 @@
 //! (`ground`), and where it is smooth by the shift it matches best, nearer than the ground's
 //! (stress s16: a rock 221 columns wide, nearly the soil's colour, of which the colour test
 //! found a 47-column corner; its smooth face left the textured test's raised pixels in
-//! pieces, and the corner's bearing 8.5 intervals off). So the pixels standing up from the ground that the colour test left out, and
-//! that join the blob, may be more of its rock: the rock holds the blob and lies within them,
-//! and its centre lies between the centres of the narrowest and the widest such spans
-//! (`ranging` widens the bearing accordingly). They stop at other blobs: a neighbour the
-//! colour test found is a rock of its own.
+//! pieces, and the corner's bearing 8.5 intervals off). So the pixels standing up from the
+//! ground that the colour test left out, and that join the blob, may be more of its rock:
+//! the rock holds the blob and lies within them, and its centre lies between the centres of
+//! the narrowest and the widest such spans (`ranging` widens the bearing accordingly). They
+//! stop at other blobs: a neighbour the colour test found is a rock of its own.
 
 use super::components::{bounds, Component};
 

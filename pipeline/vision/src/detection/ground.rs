@@ -115,7 +115,7 @@ fn band_costs(bands: &Bands) -> Costs {
 pub(super) struct GroundTest<'a> {
     tiles: Tiles<'a>,
     threshold: f32,
-    /// Both bands smoothed around each tile, for matching at shifts up to [`FACE_SHIFTS`]
+    /// Both bands smoothed around each tile, for matching at shifts up to `face_shifts`
     /// ([`GroundTest::nearer`]); made when a tile is first asked.
     faces: Vec<OnceLock<FacePlanes>>,
     /// The largest shift [`GroundTest::nearer`] tries: the nearest face any blob of the band
