@@ -160,35 +160,23 @@ impl<'a> GroundTest<'a> {
     /// nearly the soil's colour whose face the texture test leaves unknown); smooth soil
     /// matches best at the ground's shift, and its cost there is the images' noise.
     pub(super) fn nearer(&self, column: usize, row: usize, max_shift: usize) -> bool {
-        let t = row / TILE_ROWS * self.tiles.across + column / TILE_COLUMNS;
-        let (x0, y0) = self.tiles.corner(t);
-        let tile_width = TILE_COLUMNS.min(self.tiles.bands.width - x0);
+        let (t, i) = self.tiles.locate(column, row);
         let costs = self.tiles.costs(t);
-        let i = (row - y0) * tile_width + column - x0;
         let (ground, texture) = (costs.cost[i], costs.texture[i]);
         if texture > self.threshold || ground <= self.threshold {
             return false;
         }
         let bands = &self.tiles.bands;
         let planes = self.faces[t].get_or_init(|| {
-            let rows = y0..(y0 + TILE_ROWS).min(bands.rows());
+            let (rows, columns) = self.tiles.rect(t);
             let read = rows.start.saturating_sub(RADIUS)..(rows.end + RADIUS).min(bands.rows());
-            let (r, x1) = (RADIUS as isize, (x0 + tile_width) as isize);
+            let r = RADIUS as isize;
+            let (x0, x1) = (columns.start as isize, columns.end as isize);
             let reach = bands.direction * self.face_shifts as isize;
             let (low, high) = (reach.min(0), reach.max(0));
             FacePlanes {
-                own: smooth_region(
-                    bands.own,
-                    bands.width,
-                    read.clone(),
-                    x0 as isize - r..x1 + r,
-                ),
-                other: smooth_region(
-                    bands.other,
-                    bands.width,
-                    read,
-                    x0 as isize - r + low..x1 + r + high,
-                ),
+                own: smooth_region(bands.own, bands.width, read.clone(), x0 - r..x1 + r),
+                other: smooth_region(bands.other, bands.width, read, x0 - r + low..x1 + r + high),
             }
         });
         let window = row.saturating_sub(RADIUS)..(row + RADIUS + 1).min(bands.rows());
@@ -224,10 +212,7 @@ impl<'a> GroundTest<'a> {
 
     /// The stance of the pixel at `column` and `row` of the band.
     pub(super) fn stance(&self, column: usize, row: usize) -> Stance {
-        let t = row / TILE_ROWS * self.tiles.across + column / TILE_COLUMNS;
-        let (x0, y0) = self.tiles.corner(t);
-        let tile_width = TILE_COLUMNS.min(self.tiles.bands.width - x0);
-        let i = (row - y0) * tile_width + column - x0;
+        let (t, i) = self.tiles.locate(column, row);
         let costs = self.tiles.costs(t);
         stance(costs.cost[i], costs.texture[i], self.threshold)
     }
@@ -252,19 +237,29 @@ impl<'a> Tiles<'a> {
         }
     }
 
-    /// The column and row of tile `t`'s first pixel.
-    fn corner(&self, t: usize) -> (usize, usize) {
-        (t % self.across * TILE_COLUMNS, t / self.across * TILE_ROWS)
+    /// The rows and columns of tile `t`.
+    fn rect(&self, t: usize) -> (Range<usize>, Range<usize>) {
+        let (x, y) = (t % self.across * TILE_COLUMNS, t / self.across * TILE_ROWS);
+        (
+            y..(y + TILE_ROWS).min(self.bands.rows()),
+            x..(x + TILE_COLUMNS).min(self.bands.width),
+        )
+    }
+
+    /// The tile holding the pixel at `column` and `row`, and the pixel's index in the tile.
+    fn locate(&self, column: usize, row: usize) -> (usize, usize) {
+        let t = row / TILE_ROWS * self.across + column / TILE_COLUMNS;
+        let (rows, columns) = self.rect(t);
+        (
+            t,
+            (row - rows.start) * columns.len() + column - columns.start,
+        )
     }
 
     fn costs(&self, t: usize) -> &Costs {
         self.costs[t].get_or_init(|| {
-            let (x, y) = self.corner(t);
-            rect_costs(
-                &self.bands,
-                y..(y + TILE_ROWS).min(self.bands.rows()),
-                x..(x + TILE_COLUMNS).min(self.bands.width),
-            )
+            let (rows, columns) = self.rect(t);
+            rect_costs(&self.bands, rows, columns)
         })
     }
 }
