@@ -93,14 +93,22 @@ impl Gallery {
 
 /// Descriptor distance in units of the scales.
 pub fn distance(a: &Appearance, b: &Appearance, scales: &AppearanceScales) -> f64 {
-    let chroma: f64 = (0..3)
-        .map(|k| (f64::from(a.colour[k]) - f64::from(b.colour[k])).powi(2))
-        .sum::<f64>()
-        / scales.chromaticity.powi(2);
+    let chroma = chromaticity_distance(a, b, scales).powi(2);
     let log_ratio = (f64::from(a.brightness.max(1e-3)) / f64::from(b.brightness.max(1e-3))).ln();
     let brightness = (log_ratio / scales.log_brightness).powi(2);
     let texture = ((f64::from(a.texture) - f64::from(b.texture)) / scales.texture).powi(2);
     let dark =
         ((f64::from(a.dark_fraction) - f64::from(b.dark_fraction)) / scales.dark_fraction).powi(2);
     (chroma + brightness + texture + dark).sqrt()
+}
+
+/// The chromaticity part of [`distance`] alone: what stays of a rock's looks when it is seen
+/// from another side, under another light, or at another scale (brightness, texture and the
+/// shaded share change with all three).
+pub fn chromaticity_distance(a: &Appearance, b: &Appearance, scales: &AppearanceScales) -> f64 {
+    (0..3)
+        .map(|k| (f64::from(a.colour[k]) - f64::from(b.colour[k])).powi(2))
+        .sum::<f64>()
+        .sqrt()
+        / scales.chromaticity
 }
