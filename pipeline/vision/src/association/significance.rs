@@ -6,13 +6,16 @@
 //! landmarks, independently. A motion hypothesised from two seed correspondences that also
 //! brings `j − 2` more detections within `r` of a frame landmark would do so by chance with
 //! probability at most the binomial tail of `j − 2` hits among the other detections, each with
-//! probability `density · π r²`, the density taken where the landmarks lie densest (rock
-//! fields cluster: the mean density would understate chance there). Multiplied by the number of hypotheses tried, this is the
-//! expected number of chance fits as tight as the one seen, its *number of false alarms*
-//! (NFA). A fit whose NFA is far below one is no accident, whatever the sensor's error bounds:
-//! the test uses the residuals the fit achieved, not the worst case the placements allow. A
-//! residual is a [`super::placement::Separation`] distance: for elongated placements, the
-//! radius of a disc as large as the ellipse of the residual, so `π r²` stays its area.
+//! probability `density · π r²`. The density is taken where the landmarks lie densest (rock
+//! fields cluster: the mean density would understate chance there), and counts only the
+//! landmarks a detection looks like, the only ones a fit pairs it with (as in a-contrario
+//! matching of descriptors: Rabin, Delon & Gousseau 2008, "A contrario matching of SIFT-like
+//! descriptors"). Multiplied by the number of hypotheses tried, this is the expected number of
+//! chance fits as tight as the one seen, its *number of false alarms* (NFA). A fit whose NFA is
+//! far below one is no accident, whatever the sensor's error bounds: the test uses the
+//! residuals the fit achieved, not the worst case the placements allow. A residual is a
+//! [`super::placement::Separation`] distance: for elongated placements, the radius of a disc
+//! as large as the ellipse of the residual, so `π r²` stays its area.
 
 use std::f64::consts::PI;
 
@@ -22,8 +25,9 @@ use std::f64::consts::PI;
 pub(super) struct Chance {
     /// Motions hypothesised (pairs of seed correspondences).
     pub tests: f64,
-    /// Landmarks per m² where they lie densest: a chance detection near a cluster is more
-    /// likely to land near some landmark than the frame's mean density says.
+    /// Landmarks a detection looks like, per m² where the landmarks lie densest: a chance
+    /// detection near a cluster is more likely to land near some landmark than the frame's
+    /// mean density says.
     pub density: f64,
     /// Detections of the current station that could pair with one.
     pub detections: usize,
