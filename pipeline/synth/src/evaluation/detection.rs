@@ -3,6 +3,7 @@
 //! the same precision and recall for the same detections.
 
 use crate::dataset::VisibleRock;
+use qrm_core::measurement::angular_distance;
 use qrm_vision::calib::Calibration;
 use qrm_vision::detection::{Detection, DetectorSettings};
 use qrm_vision::run::DetectionRecord;
@@ -39,6 +40,27 @@ pub struct DetectedBox {
     /// `[col_min, row_min, col_max, row_max]`, inclusive; `col_max ≥ width` when it wraps.
     pub bbox: [u32; 4],
     pub contact_row: f64,
+    /// What the run measured of it, once it has a range (`stations.json`); none from the
+    /// detector alone.
+    pub measured: Option<Measured>,
+}
+
+/// A detection's bearing and fused range intervals, as the map used them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measured {
+    /// Rover-frame bearing and its half-width (radians).
+    pub bearing: f64,
+    pub bearing_uncertainty: f64,
+    /// `[low, high]`, metres; `high` may be infinite.
+    pub range: [f64; 2],
+}
+
+impl Measured {
+    /// Whether `rock`'s true bearing and range lie inside the intervals.
+    pub fn fits(&self, rock: &VisibleRock) -> bool {
+        angular_distance(self.bearing, rock.bearing) <= self.bearing_uncertainty
+            && (self.range[0]..=self.range[1]).contains(&rock.range)
+    }
 }
 
 impl From<&Detection> for DetectedBox {
@@ -47,6 +69,7 @@ impl From<&Detection> for DetectedBox {
             centroid: d.centroid,
             bbox: d.bbox,
             contact_row: d.contact_row,
+            measured: None,
         }
     }
 }
@@ -57,14 +80,23 @@ impl From<&DetectionRecord> for DetectedBox {
             centroid: d.centroid,
             bbox: d.bbox,
             contact_row: d.contact_row,
+            measured: Some(Measured {
+                bearing: d.bearing,
+                bearing_uncertainty: d.bearing_uncertainty,
+                range: d.range.fused,
+            }),
         }
     }
 }
 
 /// The rock (index into `rocks`) each detection is credited with. A detection claims the rock
 /// whose bounding box holds its centroid (a column of slack either side, half a row above and
-/// one and a half below), the nearest by centroid distance if several; a rock claimed by
-/// several detections is credited to the nearest, the others (splits) to none.
+/// one and a half below), the nearest by centroid distance if several. A detection with a
+/// measurement that claims a rock prefers one its bearing and range intervals hold, among the
+/// claimed rocks and those its own box overlaps in the centroid's column: a blob that joins a
+/// rock and the one behind it can have its centroid on the far rock and its range, from the
+/// contact row, of the near one. A rock claimed by several detections is credited to the
+/// nearest, the others (splits) to none.
 pub fn match_detections(
     detections: &[DetectedBox],
     rocks: &[VisibleRock],
@@ -73,22 +105,39 @@ pub fn match_detections(
     credit(&claims(detections, rocks, width), rocks.len())
 }
 
-/// The rock each detection claims, with the distance between their centroids.
+/// How near a claimant is to a rock, nearest first: its measurement fits the rock, its centroid
+/// lies in the rock's box, the distance between their centroids.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Nearness {
+    misfit: bool,
+    off_box: bool,
+    distance: f64,
+}
+
+impl Nearness {
+    fn order(&self, other: &Nearness) -> std::cmp::Ordering {
+        (self.misfit, self.off_box)
+            .cmp(&(other.misfit, other.off_box))
+            .then(self.distance.total_cmp(&other.distance))
+    }
+}
+
+/// The rock each detection claims, with how near it is.
 fn claims(
     detections: &[DetectedBox],
     rocks: &[VisibleRock],
     width: u32,
-) -> Vec<Option<(usize, f64)>> {
+) -> Vec<Option<(usize, Nearness)>> {
     detections.iter().map(|d| claim(d, rocks, width)).collect()
 }
 
 /// Each claimed rock credited to its nearest claimant: the rock of each detection.
-fn credit(claims: &[Option<(usize, f64)>], rocks: usize) -> Vec<Option<usize>> {
-    let mut best: Vec<Option<(usize, f64)>> = vec![None; rocks];
+fn credit(claims: &[Option<(usize, Nearness)>], rocks: usize) -> Vec<Option<usize>> {
+    let mut best: Vec<Option<(usize, Nearness)>> = vec![None; rocks];
     for (i, claim) in claims.iter().enumerate() {
-        if let Some((rock, distance)) = *claim {
-            if best[rock].is_none_or(|(_, nearest)| distance < nearest) {
-                best[rock] = Some((i, distance));
+        if let Some((rock, near)) = *claim {
+            if best[rock].is_none_or(|(_, nearest)| near.order(&nearest).is_lt()) {
+                best[rock] = Some((i, near));
             }
         }
     }
@@ -101,20 +150,33 @@ fn credit(claims: &[Option<(usize, f64)>], rocks: usize) -> Vec<Option<usize>> {
     credited
 }
 
-/// The rock a detection claims, with the distance between their centroids.
-fn claim(d: &DetectedBox, rocks: &[VisibleRock], width: u32) -> Option<(usize, f64)> {
-    rocks
+/// The rock a detection claims, with how near it is: none unless its centroid lies in a rock's
+/// box.
+fn claim(d: &DetectedBox, rocks: &[VisibleRock], width: u32) -> Option<(usize, Nearness)> {
+    let near: Vec<(usize, Nearness)> = rocks
         .iter()
         .enumerate()
         .filter(|(_, r)| in_columns(d.centroid[0], r.bbox, width))
-        .filter(|(_, r)| {
-            (f64::from(r.bbox[1]) - 0.5..=f64::from(r.bbox[3]) + 1.5).contains(&d.centroid[1])
+        .filter_map(|(k, r)| {
+            let in_box =
+                (f64::from(r.bbox[1]) - 0.5..=f64::from(r.bbox[3]) + 1.5).contains(&d.centroid[1]);
+            let fits = d.measured.is_some_and(|m| m.fits(r));
+            let overlaps = r.bbox[1] <= d.bbox[3] && r.bbox[3] >= d.bbox[1];
+            (in_box || (fits && overlaps)).then(|| {
+                let dc = column_gap(d.centroid[0], r.centroid[0], width);
+                let near = Nearness {
+                    misfit: !fits,
+                    off_box: !in_box,
+                    distance: dc.hypot(d.centroid[1] - r.centroid[1]),
+                };
+                (k, near)
+            })
         })
-        .map(|(k, r)| {
-            let dc = column_gap(d.centroid[0], r.centroid[0], width);
-            (k, dc.hypot(d.centroid[1] - r.centroid[1]))
-        })
-        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .collect();
+    if near.iter().all(|(_, n)| n.off_box) {
+        return None;
+    }
+    near.into_iter().min_by(|a, b| a.1.order(&b.1))
 }
 
 fn column_gap(a: f64, b: f64, width: u32) -> f64 {
@@ -160,16 +222,25 @@ pub struct Score {
 }
 
 impl Score {
-    /// Adds one image; returns the rock (index into `rocks`) credited to each detection.
+    /// Adds one image. The detector is scored on its boxes alone, whatever was measured of
+    /// them later, so that a run and the detection benchmark give the same figures for the
+    /// same detections.
     pub fn add(
         &mut self,
         detections: &[DetectedBox],
         rocks: &[VisibleRock],
         calib: &Calibration,
         detectable: Detectable,
-    ) -> Vec<Option<usize>> {
+    ) {
         let width = calib.image.width;
-        let claims = claims(detections, rocks, width);
+        let boxes: Vec<DetectedBox> = detections
+            .iter()
+            .map(|d| DetectedBox {
+                measured: None,
+                ..*d
+            })
+            .collect();
+        let claims = claims(&boxes, rocks, width);
         let credited = credit(&claims, rocks.len());
         self.images += 1;
         self.detections += detections.len();
@@ -192,7 +263,6 @@ impl Score {
                 None => {}
             }
         }
-        credited
     }
 
     fn add_found(&mut self, d: &DetectedBox, rock: &VisibleRock, calib: &Calibration) {
@@ -250,4 +320,97 @@ pub fn median_and_max(values: &[f64]) -> (f64, f64) {
         v.get(v.len() / 2).copied().unwrap_or(0.0),
         v.last().copied().unwrap_or(0.0),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rock(id: u32, bbox: [u32; 4], range: f64) -> VisibleRock {
+        let centroid = [
+            f64::from(bbox[0] + bbox[2] + 1) / 2.0,
+            f64::from(bbox[1] + bbox[3] + 1) / 2.0,
+        ];
+        VisibleRock {
+            id,
+            pixels: 20,
+            bbox,
+            centroid,
+            bearing: 5.075,
+            bearing_column: centroid[0],
+            range,
+            contact: [centroid[0], f64::from(bbox[3]) + 1.0],
+        }
+    }
+
+    /// A stack seen on the 1 000-rock drive of `sparse-large` (station 281): the far rock's
+    /// rows 159–162 lie just above the near rock's 164–167, at the same bearing.
+    fn stack() -> Vec<VisibleRock> {
+        vec![
+            rock(731, [1411, 159, 1424, 162], 39.0),
+            rock(844, [1413, 164, 1421, 167], 27.5),
+        ]
+    }
+
+    /// One blob over both rocks, its centroid on the far one.
+    fn blob(range: [f64; 2]) -> DetectedBox {
+        DetectedBox {
+            centroid: [1416.4, 162.7],
+            bbox: [1411, 157, 1421, 167],
+            contact_row: 168.0,
+            measured: Some(Measured {
+                bearing: 5.084,
+                bearing_uncertainty: 0.0097,
+                range,
+            }),
+        }
+    }
+
+    #[test]
+    fn a_blob_over_a_stack_is_the_rock_its_measurement_fits() {
+        assert_eq!(
+            match_detections(&[blob([25.1, 30.4])], &stack(), 4096),
+            vec![Some(1)]
+        );
+    }
+
+    #[test]
+    fn a_blob_fitting_no_rock_is_the_rock_under_its_centroid() {
+        for range in [[10.0, 12.0], [25.1, 45.0]] {
+            assert_eq!(
+                match_detections(&[blob(range)], &stack(), 4096),
+                vec![Some(0)]
+            );
+        }
+    }
+
+    #[test]
+    fn without_a_measurement_the_centroid_decides() {
+        let detector_only = DetectedBox {
+            measured: None,
+            ..blob([25.1, 30.4])
+        };
+        assert_eq!(
+            match_detections(&[detector_only], &stack(), 4096),
+            vec![Some(0)]
+        );
+    }
+
+    #[test]
+    fn a_fitting_claim_outranks_a_nearer_one_that_does_not_fit() {
+        let piece = DetectedBox {
+            centroid: [1417.4, 166.0],
+            bbox: [1415, 165, 1420, 167],
+            measured: Some(Measured {
+                bearing: 5.075,
+                bearing_uncertainty: 0.001,
+                range: [10.0, 12.0],
+            }),
+            ..blob([25.1, 30.4])
+        };
+        assert_eq!(
+            match_detections(&[piece, blob([25.1, 30.4])], &stack(), 4096),
+            vec![None, Some(1)]
+        );
+    }
 }

@@ -1,7 +1,7 @@
 //! Scoring the front end image by image: detections ([`Score`]), bearings, range cues and
 //! the asserted range order, against the truth rock each detection is credited with.
 
-use super::detection::{ratio, Detectable, DetectedBox, Score};
+use super::detection::{match_detections, ratio, Detectable, DetectedBox, Score};
 use super::{BearingScore, CueScore, DetectionScore, FrontEndScore, RangeScore};
 use crate::dataset::{ImageTruth, Truth};
 use qrm_core::measurement::angular_distance;
@@ -47,7 +47,8 @@ impl Tally {
         fused: &HashSet<(usize, usize)>,
     ) {
         let boxes: Vec<DetectedBox> = record.detections.iter().map(DetectedBox::from).collect();
-        let credited = self.detection.add(&boxes, &image.rocks, calib, detectable);
+        self.detection.add(&boxes, &image.rocks, calib, detectable);
+        let credited = match_detections(&boxes, &image.rocks, calib.image.width);
         let station = &truth.stations[image.station];
         // True bearing and range of a rock from the station centre.
         let polar = |id: u32| {
