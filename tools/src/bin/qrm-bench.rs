@@ -5,6 +5,8 @@
 //! - with `--closure`: path-consistency closure of complete random maps (000 §VI-B);
 //! - with `--rng`: the RNG estimate (000 Algorithm 2) of maps of N landmarks, as a run makes
 //!   after every station;
+//! - with `--layout`: the graph layout of the RNG drawing of N landmarks, as the MCAP
+//!   recording makes at every station that changes the map;
 //! - with `--render`: synthetic panoramas (issue 4), one stereo pair and a 50-station set;
 //! - with `--triple-calls K`: one triple measured K times, the work of a Python `qrm.measure`.
 
@@ -55,6 +57,10 @@ struct Args {
     /// pair an edge, every third landmark examined: the slowest case) (repeatable).
     #[arg(long, num_args = 1.., value_name = "N")]
     rng: Vec<usize>,
+    /// Time the spring layout of an RNG drawing of N landmarks (each joined to its next 3 by
+    /// index, about the degree of a long drive's estimate) (repeatable).
+    #[arg(long, num_args = 1.., value_name = "N")]
+    layout: Vec<usize>,
     /// Time the synthetic renderer instead (30 rocks, `calib/default.toml`).
     #[arg(long)]
     render: bool,
@@ -414,8 +420,36 @@ fn bench_rng(n: usize) {
     );
 }
 
+/// Times `qrm_plot::spring_layout` of `n` landmarks (the median of 3).
+fn bench_layout(n: usize) {
+    let edges: Vec<(usize, usize)> = (0..n)
+        .flat_map(|i| (1..=3).map(move |d| (i, (i + d) % n)))
+        .filter(|(i, j)| i != j)
+        .collect();
+    let mut times: Vec<f64> = (0..3)
+        .map(|_| {
+            let start = Instant::now();
+            let layout = qrm_plot::spring_layout(n, &edges);
+            assert_eq!(layout.len(), n);
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    println!(
+        "spring layout, {n} landmarks, {} edges: median {:.1} ms",
+        edges.len(),
+        times[1]
+    );
+}
+
 fn main() {
     let args = Args::parse();
+    if !args.layout.is_empty() {
+        for &n in &args.layout {
+            bench_layout(n);
+        }
+        return;
+    }
     if let Some(dir) = &args.detect {
         if let Err(e) = bench_detect(dir) {
             eprintln!("qrm-bench: {e:#}");
