@@ -712,23 +712,13 @@ fn proposals(
     gallery: &Gallery,
     settings: &AssociationSettings,
 ) -> Vec<(LandmarkId, f64)> {
-    let mut out: Vec<(LandmarkId, f64)> = gallery
-        .profiles
-        .iter()
-        .filter(|p| match (p.width, evidence.width) {
+    within_gate(gallery, settings, |p| {
+        let width_agrees = match (p.width, evidence.width) {
             (Some(a), Some(b)) => a.intersection(b).is_some(),
             _ => true,
-        })
-        .map(|p| {
-            (
-                p.landmark,
-                distance(&evidence.appearance, &p.appearance, &settings.scales),
-            )
-        })
-        .filter(|&(_, d)| d <= settings.gate)
-        .collect();
-    out.sort_by(|a, b| a.1.total_cmp(&b.1));
-    out
+        };
+        width_agrees.then(|| distance(&evidence.appearance, &p.appearance, &settings.scales))
+    })
 }
 
 /// The landmarks whose colour is within the gate of the detection's, whatever their other
@@ -739,13 +729,26 @@ fn colour_proposals(
     gallery: &Gallery,
     settings: &AssociationSettings,
 ) -> Vec<(LandmarkId, f64)> {
+    within_gate(gallery, settings, |p| {
+        Some(chromaticity_distance(
+            &evidence.appearance,
+            &p.appearance,
+            &settings.scales,
+        ))
+    })
+}
+
+/// The gallery's landmarks whose `distance` (none: not a candidate at all) is within the
+/// gate, nearest first.
+fn within_gate(
+    gallery: &Gallery,
+    settings: &AssociationSettings,
+    distance: impl Fn(&Profile) -> Option<f64>,
+) -> Vec<(LandmarkId, f64)> {
     let mut out: Vec<(LandmarkId, f64)> = gallery
         .profiles
         .iter()
-        .map(|p| {
-            let d = chromaticity_distance(&evidence.appearance, &p.appearance, &settings.scales);
-            (p.landmark, d)
-        })
+        .filter_map(|p| distance(p).map(|d| (p.landmark, d)))
         .filter(|&(_, d)| d <= settings.gate)
         .collect();
     out.sort_by(|a, b| a.1.total_cmp(&b.1));
