@@ -565,6 +565,15 @@ fn anchors(
     pairs.dedup();
     let conflicted =
         |&(i, l): &(usize, LandmarkId)| pairs.iter().any(|&(j, m)| (j == i) != (m == l));
+    // The station's other placed detections: an unmapped rock one of them lies at is theirs.
+    let others = |i: usize| -> Vec<Placed> {
+        placed
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| k != i)
+            .filter_map(|(_, p)| *p)
+            .collect()
+    };
     // Frames that hold a landmark but pair it with no detection, or another, doubt the pair.
     let agreed = |&(i, l): &(usize, LandmarkId)| {
         let supporting = || {
@@ -594,7 +603,14 @@ fn anchors(
         let short = !doubtful[i] && placed[i].is_none_or(|p| p.reach() <= ANCHOR_RADIUS_M);
         2 * support > holding
             && support >= min_support
-            && (short || long_anchor(&supporting().collect::<Vec<_>>(), holding, placed[i], l))
+            && (short
+                || long_anchor(
+                    &supporting().collect::<Vec<_>>(),
+                    holding,
+                    placed[i],
+                    l,
+                    &others(i),
+                ))
     };
     pairs
         .iter()
@@ -661,6 +677,7 @@ fn long_anchor(
     holding: usize,
     placed: Option<Placed>,
     l: LandmarkId,
+    others: &[Placed],
 ) -> bool {
     let Some(p) = placed else {
         return false;
@@ -668,7 +685,9 @@ fn long_anchor(
     supporting.len() == holding
         && supporting.len() >= 2
         && supporting.iter().any(|(frame, _)| !frame.accumulated)
-        && supporting.iter().all(|(frame, r)| !r.crowded(frame, &p, l))
+        && supporting
+            .iter()
+            .all(|(frame, r)| !r.crowded(frame, &p, l, others))
 }
 
 /// Re-tests one held-back detection of an earlier station against the current map (000 §VI-C
@@ -1265,6 +1284,17 @@ mod tests {
         };
         assert!(!anchored(&unmapped([12.0, 0.0])));
         assert!(anchored(&unmapped([15.0, 0.0])));
+        // Unless another detection of the station lies at the unmapped rock: it is that one's.
+        let beside_it = |other: [f64; 2]| {
+            let registrations = [
+                (&landmark, pairing.clone()),
+                (&unmapped([12.0, 0.0]), pairing.clone()),
+            ];
+            let placed = [placed[0], Some(Placed::along(other, 0.0, 0.3, 0.1))];
+            !anchors(&registrations, &candidates, &placed, &[false, false], 1).is_empty()
+        };
+        assert!(beside_it([12.2, 0.0]));
+        assert!(!beside_it([20.0, 0.0]), "the other detection is elsewhere");
         // A detection placed within 2 m anchors on one frame's pairing.
         let near = [Some(Placed::along([10.0, 0.0], 0.0, 1.5, 0.1))];
         assert!(!anchors(
