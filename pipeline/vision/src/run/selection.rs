@@ -84,8 +84,8 @@ pub(crate) fn usable_firm(
 /// of their bearing intervals held the truth (98.8 % of the used ones'), 99.7 % and 95.5 % of
 /// their fused range intervals (99.7 %). A luminance piece steers where its range is
 /// corroborated ([`corroborated`]): its placement then no longer rests on where the stereo
-/// window put the blob's sides (stop 59: JPEG marsyard seed 11 22.0 → 45.6 % fused, 0 unsound
-/// on 14 sets, docs/RUN.md).
+/// window put the blob's sides (stop 59: JPEG marsyard seed 11 22.0 → 45.6 % fused, no unsound
+/// relation added on 16 sets, docs/RUN.md).
 fn observes(station: &StationDetections, ranged: &[Ranged], i: usize) -> bool {
     doubted(&station.primary[i])
         || (station.channels == Channels::Luminance && ranged[i].piece && !corroborated(&ranged[i]))
