@@ -638,24 +638,24 @@ impl Registration {
     /// more than 0.2 points, purity unchanged, docs/RUN.md.)
     pub fn crowded(&self, frame: &Frame, p: &Placed, l: LandmarkId, others: &[Placed]) -> bool {
         let motion = self.motion();
-        let accounted = |g: &Placed| {
-            others.iter().any(|o| {
-                let theirs = motion.separation(o, g);
-                theirs.within() && theirs.distance < motion.separation(p, g).distance
-            })
-        };
-        frame
+        let other_landmark = frame
             .landmarks
             .iter()
             .filter(|m| m.0 != l)
-            .map(|m| &m.1)
-            .chain(
-                frame
-                    .unmapped
-                    .iter()
-                    .filter(|g| g.reach() <= LONG_ANCHOR_RADIUS_M && !accounted(g)),
-            )
-            .any(|g| motion.separation(p, g).within())
+            .any(|m| motion.separation(p, &m.1).within());
+        other_landmark
+            || frame
+                .unmapped
+                .iter()
+                .filter(|g| g.reach() <= LONG_ANCHOR_RADIUS_M)
+                .any(|g| {
+                    let ours = motion.separation(p, g);
+                    ours.within()
+                        && !others.iter().any(|o| {
+                            let theirs = motion.separation(o, g);
+                            theirs.within() && theirs.distance < ours.distance
+                        })
+                })
     }
 
     /// Where the current station's point `p` lies in the frame's coordinates.
