@@ -50,7 +50,8 @@ pub struct RunArgs {
     pub rrd: bool,
     /// What tells rocks from the ground: `luminance` uses brightness and stereo height only
     /// (grayscale cameras, and colour that cannot be trusted: JPEG, strong sensor noise);
-    /// `auto` picks it for grayscale panoramas and JPEG stereo pairs, colour otherwise.
+    /// `auto` picks it for grayscale panoramas, and for stereo pairs that are JPEG or whose
+    /// chroma noise is over a third of the colour test's threshold, colour otherwise.
     #[arg(long, value_enum, default_value_t = ChannelsArg::Auto)]
     pub channels: ChannelsArg,
     /// Annotated panoramas in OUT/panoramas/: `reduced` (scaled by a power of two to 1025-2048

@@ -112,7 +112,12 @@ pub fn detect_panoramas(
     calib: &Calibration,
     settings: &DetectorSettings,
 ) -> StationDetections {
-    let channels = settings.channels.resolve_file(primary, jpeg);
+    let channels = match right {
+        Some(_) => settings
+            .channels
+            .resolve_stereo(primary, jpeg, settings.chroma_drop),
+        None => settings.channels.resolve(primary),
+    };
     let settings = &DetectorSettings {
         channels,
         ..settings.clone()

@@ -20,7 +20,7 @@ pub struct StationRecord {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub digests: Vec<String>,
     /// What told rocks from the ground in its panorama: `colour`, or `luminance` (and stereo
-    /// height) for grayscale or JPEG panoramas.
+    /// height) for grayscale, JPEG or noisy-colour panoramas.
     #[serde(default)]
     pub channels: crate::detection::Channels,
     /// Detections in the primary (left or mono) panorama, in column order.

@@ -12,8 +12,8 @@ pub struct RunSummary {
     pub stations: usize,
     /// Stations whose primary image could not be used.
     pub stations_skipped: usize,
-    /// Stations detected by luminance and stereo height (grayscale or JPEG panoramas); the
-    /// others by colour.
+    /// Stations detected by luminance and stereo height (grayscale, JPEG or noisy-colour
+    /// panoramas); the others by colour.
     #[serde(default)]
     pub stations_luminance: usize,
     /// Stations read, but with fewer than three usable detections: they add nothing.
@@ -165,11 +165,11 @@ impl fmt::Display for RunSummary {
             0 => writeln!(f, "rocks told from the ground by colour")?,
             n if n == self.stations => writeln!(
                 f,
-                "rocks told from the ground by luminance and stereo height (grayscale or JPEG panoramas)"
+                "rocks told from the ground by luminance and stereo height (grayscale, JPEG, or colour too noisy to trust)"
             )?,
             n => writeln!(
                 f,
-                "rocks told from the ground by luminance and stereo height at {n} stations (grayscale or JPEG), by colour at the others"
+                "rocks told from the ground by luminance and stereo height at {n} stations (grayscale, JPEG, or colour too noisy to trust), by colour at the others"
             )?,
         }
         writeln!(
