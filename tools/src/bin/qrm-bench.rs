@@ -93,7 +93,7 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
     let settings = DetectorSettings::default();
     let size = (calib.image.width, calib.image.height);
     let read = |p: &std::path::Path| qrm_vision::survey::read_image(p, size);
-    let (mut decode, mut detecting) = (0.0, Vec::new());
+    let (mut decode, mut choosing, mut detecting) = (0.0, 0.0, Vec::new());
     let mut score = Score::default();
     let mut ambiguous = 0;
     for file in &files {
@@ -116,10 +116,29 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
         let open = |p: Option<std::path::PathBuf>| p.map(|p| read(&p));
         let (right, left) = (open(right).transpose()?, open(left).transpose()?);
         decode += start.elapsed().as_secs_f64();
+        // The mode as the run resolves it (`run::front_end::detect_panoramas`): from the left
+        // image of a stereo pair, which may be detected by luminance for its chroma noise.
+        let start = Instant::now();
+        let channels = match (&right, &left) {
+            (Some(_), _) => settings
+                .channels
+                .resolve_stereo(&image, false, settings.chroma_drop),
+            (None, Some(left)) => {
+                settings
+                    .channels
+                    .resolve_stereo(left, false, settings.chroma_drop)
+            }
+            (None, None) => settings.channels,
+        };
+        choosing += start.elapsed().as_secs_f64();
+        let settings = &DetectorSettings {
+            channels,
+            ..settings.clone()
+        };
         let start = Instant::now();
         let found = match &left {
-            Some(left) => detect_right(&image, Some(left), &calib, &settings),
-            None => detect(&image, right.as_ref(), &calib, &settings),
+            Some(left) => detect_right(&image, Some(left), &calib, settings),
+            None => detect(&image, right.as_ref(), &calib, settings),
         };
         detecting.push(start.elapsed().as_secs_f64());
         if let Some(t) = truth
@@ -127,18 +146,19 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
             .and_then(|t| t.images.iter().find(|i| i.file == name))
         {
             let boxes: Vec<DetectedBox> = found.iter().map(DetectedBox::from).collect();
-            score.add(&boxes, &t.rocks, &calib, Detectable::of(&settings));
+            score.add(&boxes, &t.rocks, &calib, Detectable::of(settings));
             ambiguous += found.iter().filter(|d| d.ambiguous).count();
         }
     }
     let n = files.len().max(1) as f64;
     detecting.sort_by(f64::total_cmp);
     println!(
-        "detect: {} images {}x{}: decode {:.1} ms/image (a left image's right partner included), detect mean {:.1} ms, median {:.1} ms, max {:.1} ms",
+        "detect: {} images {}x{}: decode {:.1} ms/image (a left image's right partner included), mode choice {:.1} ms, detect mean {:.1} ms, median {:.1} ms, max {:.1} ms",
         files.len(),
         calib.image.width,
         calib.image.height,
         1e3 * decode / n,
+        1e3 * choosing / n,
         1e3 * detecting.iter().sum::<f64>() / n,
         1e3 * detecting.get(detecting.len() / 2).copied().unwrap_or(0.0),
         1e3 * detecting.last().copied().unwrap_or(0.0),
