@@ -112,7 +112,8 @@ pub struct Mapper<C: Calculus> {
     /// Every station that fused landmarks, in order: the recent ones' frames are registered
     /// against ([`Mapper::recent`]), all of them make 002's beliefs (`super::beliefs`).
     pub sighted: Vec<Sighted>,
-    /// Held-back observations given up after [`HOLD_STATIONS`].
+    /// Held-back observations given up: unrecognised after [`RECENT_FRAMES`] stations, or
+    /// left without partners to be measured with.
     pub expired: usize,
     next_landmark: LandmarkId,
     /// `(station, detection) → landmark` for every fused detection, for evaluation.
@@ -801,9 +802,10 @@ impl<C: Calculus> Mapper<C> {
 /// back as a new landmark.
 const RECENT_FRAMES: usize = 6;
 
-/// Stations a held-back observation waits for the map to tighten before it is given up (an
-/// observation not fused loses information, never soundness). One: on the presets no
-/// observation resolved at a second retry, and every retry measures again.
+/// Stations at which a held-back observation is re-tested on the tightened map (an observation
+/// not fused loses information, never soundness). One: on the presets no observation resolved
+/// at a second retry, and every retry measures again; at stop 59 none resolved at the first
+/// either, on any set. It waits to be recognised for [`RECENT_FRAMES`] stations.
 const HOLD_STATIONS: usize = 1;
 
 /// Stations that must recognise a held-back observation, all as the same landmark, before it
