@@ -119,17 +119,8 @@ fn bench_detect(dir: &std::path::Path) -> anyhow::Result<()> {
         // The mode as the run resolves it (`run::front_end::detect_panoramas`): from the left
         // image of a stereo pair, which may be detected by luminance for its chroma noise.
         let start = Instant::now();
-        let channels = match (&right, &left) {
-            (Some(_), _) => settings
-                .channels
-                .resolve_stereo(&image, false, settings.chroma_drop),
-            (None, Some(left)) => {
-                settings
-                    .channels
-                    .resolve_stereo(left, false, settings.chroma_drop)
-            }
-            (None, None) => settings.channels,
-        };
+        let primary = left.as_ref().unwrap_or(&image);
+        let channels = settings.channels_of(primary, right.is_some() || left.is_some(), false);
         choosing += start.elapsed().as_secs_f64();
         let settings = &DetectorSettings {
             channels,

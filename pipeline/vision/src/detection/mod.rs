@@ -116,19 +116,24 @@ impl Channels {
             other => other,
         }
     }
+}
 
-    /// [`Channels::resolve`] for the left panorama of a stereo pair, where luminance can tell
-    /// rocks from cast shadows: `Auto` is resolved to luminance also for a JPEG pair (`jpeg`:
-    /// its chroma is subsampled and quantised, and the per-pixel chroma test fires on the
-    /// artefacts) and for a panorama whose chroma noise ([`noise::chroma_noise`], over the
-    /// lower [`NOISE_ROWS`] of its rows) exceeds [`NOISE_SHARE`] of `chroma_drop`: the chroma
-    /// test then fires on the soil's own pixels, which join into blobs spanning the ground.
-    pub fn resolve_stereo(self, image: &image::RgbImage, jpeg: bool, chroma_drop: f32) -> Channels {
-        match self.resolve(image) {
+impl DetectorSettings {
+    /// The mode a panorama is detected in: [`Channels::resolve`], and where a stereo partner
+    /// lets luminance tell rocks from cast shadows (`stereo`), `Auto` is resolved to luminance
+    /// also for a JPEG pair (`jpeg`: its chroma is subsampled and quantised, and the per-pixel
+    /// chroma test fires on the artefacts) and for a panorama whose chroma noise
+    /// ([`noise::chroma_noise`], over the lower [`NOISE_ROWS`] of its rows) exceeds
+    /// [`NOISE_SHARE`] of `chroma_drop`: the chroma test then fires on the soil's own pixels,
+    /// which join into blobs spanning the ground. `primary` is the pair's left panorama.
+    pub fn channels_of(&self, primary: &image::RgbImage, stereo: bool, jpeg: bool) -> Channels {
+        match self.channels.resolve(primary) {
             Channels::Colour
-                if self == Channels::Auto
+                if stereo
+                    && self.channels == Channels::Auto
                     && (jpeg
-                        || noise::chroma_noise(image, NOISE_ROWS) > NOISE_SHARE * chroma_drop) =>
+                        || noise::chroma_noise(primary, NOISE_ROWS)
+                            > NOISE_SHARE * self.chroma_drop) =>
             {
                 Channels::Luminance
             }
@@ -919,10 +924,14 @@ mod tests {
     }
 
     /// A stereo pair is detected by luminance when JPEG or when its chroma is noisy; a
-    /// requested mode stands.
+    /// requested mode stands, and a panorama without a stereo partner keeps its colour.
     #[test]
     fn noisy_or_jpeg_colour_of_a_stereo_pair_is_detected_by_luminance() {
-        let drop = DetectorSettings::default().chroma_drop;
+        let auto = DetectorSettings::default();
+        let colour = DetectorSettings {
+            channels: Channels::Colour,
+            ..DetectorSettings::default()
+        };
         // Soil and greyer soil in alternate columns: adjacent pixels differ in chroma by 0.12.
         let striped = image::RgbImage::from_fn(64, 10, |x, _| {
             if x % 2 == 0 {
@@ -932,22 +941,16 @@ mod tests {
             }
         });
         let clean = image::RgbImage::from_pixel(64, 10, image::Rgb([150, 90, 60]));
-        assert_eq!(
-            Channels::Auto.resolve_stereo(&clean, false, drop),
-            Channels::Colour
-        );
-        assert_eq!(
-            Channels::Auto.resolve_stereo(&clean, true, drop),
-            Channels::Luminance
-        );
-        assert_eq!(
-            Channels::Auto.resolve_stereo(&striped, false, drop),
-            Channels::Luminance
-        );
-        assert_eq!(
-            Channels::Colour.resolve_stereo(&striped, true, drop),
-            Channels::Colour
-        );
+        let cases = [
+            (&auto, &clean, true, false, Channels::Colour),
+            (&auto, &clean, true, true, Channels::Luminance),
+            (&auto, &striped, true, false, Channels::Luminance),
+            (&colour, &striped, true, true, Channels::Colour),
+            (&auto, &striped, false, false, Channels::Colour),
+        ];
+        for (settings, image, stereo, jpeg, mode) in cases {
+            assert_eq!(settings.channels_of(image, stereo, jpeg), mode);
+        }
     }
 
     /// A one-pixel crack inside a blob is bridged; the blob does not grow, even at the edge.

@@ -112,12 +112,7 @@ pub fn detect_panoramas(
     calib: &Calibration,
     settings: &DetectorSettings,
 ) -> StationDetections {
-    let channels = match right {
-        Some(_) => settings
-            .channels
-            .resolve_stereo(primary, jpeg, settings.chroma_drop),
-        None => settings.channels.resolve(primary),
-    };
+    let channels = settings.channels_of(primary, right.is_some(), jpeg);
     let settings = &DetectorSettings {
         channels,
         ..settings.clone()
