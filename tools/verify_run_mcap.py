@@ -35,7 +35,7 @@ EXPECTED = {
     ),
     "/measurements": (
         {"index", "station", "files", "landmarks", "triples", "relations_tightened",
-         "resolved_held_back", "contradiction", "warnings"},
+         "resolved_held_back", "recognised", "contradiction", "warnings"},
         {},
     ),
     "/map_metrics": (

@@ -148,7 +148,8 @@ impl<C: Calculus> KnownMap<C> {
                 &evidence,
                 settings,
                 &|_| true,
-            );
+            )
+            .decisions;
             for (&i, decision) in usable.iter().zip(decisions) {
                 match decision {
                     Decision::Matched(landmark) => identified.push((i, landmark)),

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::{Problem, Recorder, RecordingError, RngDrawing};
 use qrm_atomic_file::Temporary;
-use qrm_vision::run::{Association, MetricsRecord, StageSeconds, StationRecord};
+use qrm_vision::run::{Association, LateSighting, MetricsRecord, StageSeconds, StationRecord};
 
 /// The channels, in the order their ids are kept.
 #[derive(Clone, Copy)]
@@ -235,6 +235,7 @@ impl McapRecorder {
                 triples: f.triples,
                 relations_tightened: f.relations_tightened,
                 resolved_held_back: f.resolved_held_back,
+                recognised: &f.recognised,
                 contradiction: f.contradiction.as_deref(),
                 warnings: &r.warnings,
             },
@@ -379,6 +380,7 @@ struct MeasurementsMessage<'a> {
     triples: usize,
     relations_tightened: usize,
     resolved_held_back: usize,
+    recognised: &'a [LateSighting],
     contradiction: Option<&'a str>,
     warnings: &'a [String],
 }

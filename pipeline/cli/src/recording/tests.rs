@@ -87,6 +87,7 @@ fn station(index: usize) -> StationRecord {
             triples: count * (count - 1) * (count - 2) / 6,
             relations_tightened: index,
             resolved_held_back: index % 2,
+            recognised: Vec::new(),
             contradiction: (index == 5).then(|| "triple (1, 2, 3) emptied".to_string()),
             splits: Vec::new(),
         },

@@ -46,6 +46,7 @@ mod disc_grid;
 mod gallery;
 mod placement;
 mod recency;
+mod recognition;
 mod registration;
 mod significance;
 pub mod sketch;
@@ -56,6 +57,7 @@ use gallery::chromaticity_distance;
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
 pub use placement::Placed;
 pub use recency::LastSeen;
+pub use recognition::Recognition;
 pub use registration::{displacement, register, Frame, Registration};
 use registration::{ANCHOR_RADIUS_M, LONG_ANCHOR_RADIUS_M, MIN_INLIERS, SIGNIFICANT_NFA};
 pub use sketch::Sketch;
@@ -200,6 +202,14 @@ pub enum Decision {
     Withheld(Unfounded),
 }
 
+/// One station's association: each detection's decision, and the unmapped rocks of earlier
+/// stations its anchors recognised ([`recognition`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StationAssociation {
+    pub decisions: Vec<Decision>,
+    pub recognitions: Vec<Recognition>,
+}
+
 /// Why a detection that matched no landmark founds none of its own ([`unfounded`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Unfounded {
@@ -263,12 +273,15 @@ pub fn associate<C: Calculus>(
     station: &StationEvidence,
     settings: &AssociationSettings,
     lately: &(dyn Fn(LandmarkId) -> bool + Sync),
-) -> Vec<Decision> {
+) -> StationAssociation {
     let (view, evidence) = (&station.view, &station.detections);
     let placed: Vec<Option<Placed>> = evidence.iter().map(|e| e.placed).collect();
     let n = evidence.len();
     if gallery.is_empty() {
-        return evidence.iter().map(founded).collect();
+        return StationAssociation {
+            decisions: evidence.iter().map(founded).collect(),
+            recognitions: Vec::new(),
+        };
     }
     let candidates: Vec<Vec<(LandmarkId, f64)>> = evidence
         .iter()
@@ -332,8 +345,10 @@ pub fn associate<C: Calculus>(
     let candidates = placed_near(candidates, &registrations, &placed);
     drop_inconsistent_anchors(map, view, &mut anchors);
     let anchored: Vec<Sighting> = anchors.iter().map(|a| Sighting::new(a.0, a.1)).collect();
+    let recognitions =
+        recognition::recognitions(frames, &registrations, &placed, &doubtful, &anchored);
     let recent = |l: LandmarkId| frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
-    (0..n)
+    let decisions = (0..n)
         .into_par_iter()
         .map(|i| match anchored.iter().find(|a| a.position == i) {
             Some(anchor) => Decision::Matched(anchor.landmark),
@@ -360,7 +375,11 @@ pub fn associate<C: Calculus>(
                 }
             }
         })
-        .collect()
+        .collect();
+    StationAssociation {
+        decisions,
+        recognitions,
+    }
 }
 
 /// The landmarks of the registered frames, none anchored at this station, that lie within
@@ -1009,6 +1028,7 @@ mod tests {
             &AssociationSettings::default(),
             lately,
         )
+        .decisions
     }
 
     /// Associates `station`, of three detections, as the first station: the first and third

@@ -658,6 +658,41 @@ impl Registration {
                 })
     }
 
+    /// The frame's unmapped rock (index into [`Frame::unmapped`]) that the current station's
+    /// detection `i` is, by the fit's own test of an unambiguous partner: both placed no looser
+    /// than an anchor ([`ANCHOR_RADIUS_M`]), within the pair's separation, every landmark and
+    /// every other unmapped rock of the frame clearly farther from the detection, and every
+    /// other placed detection of the station clearly farther from the rock.
+    pub fn recognised(&self, frame: &Frame, current: &[Option<Placed>], i: usize) -> Option<usize> {
+        let motion = self.motion();
+        let p = current[i].filter(|p| p.reach() <= ANCHOR_RADIUS_M)?;
+        let (g, separation) = frame
+            .unmapped
+            .iter()
+            .enumerate()
+            .map(|(g, q)| (g, motion.separation(&p, q)))
+            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))?;
+        let q = frame.unmapped[g];
+        let near = UNIQUE * separation.distance + SLACK_M;
+        let alone = frame
+            .landmarks
+            .iter()
+            .map(|m| &m.1)
+            .chain(
+                frame
+                    .unmapped
+                    .iter()
+                    .enumerate()
+                    .filter(|&(k, _)| k != g)
+                    .map(|(_, o)| o),
+            )
+            .all(|o| motion.separation(&p, o).distance > near);
+        let unrivalled = current.iter().enumerate().all(|(k, other)| {
+            k == i || other.is_none_or(|o| motion.separation(&o, &q).distance > near)
+        });
+        (separation.within() && q.reach() <= ANCHOR_RADIUS_M && alone && unrivalled).then_some(g)
+    }
+
     /// Where the current station's point `p` lies in the frame's coordinates.
     pub fn to_frame(&self, p: [f64; 2]) -> [f64; 2] {
         self.motion().apply(p)

@@ -14,6 +14,6 @@ pub use summary::{BeliefsSummary, RunSummary};
 pub use traverse::{traverse_survey, Progress, Quiet, RunError, RunSettings, Stage, Traverse};
 
 pub use record::{
-    Association, DetectionRecord, Exclusion, FusionRecord, MetricsRecord, RangeRecord,
-    StageSeconds, StationRecord,
+    Association, DetectionRecord, Exclusion, FusionRecord, LateSighting, MetricsRecord,
+    RangeRecord, StageSeconds, StationRecord,
 };

@@ -158,11 +158,25 @@ pub struct FusionRecord {
     pub relations_tightened: usize,
     /// Held-back observations of earlier panoramas resolved and fused at this station.
     pub resolved_held_back: usize,
+    /// Held-back observations of earlier panoramas that a detection of this one recognised
+    /// (`association::recognition`) and that were fused as its landmark. The earlier
+    /// station's record keeps the decision made when it was mapped.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub recognised: Vec<LateSighting>,
     /// Why the map rejected the panorama, if it did.
     pub contradiction: Option<String>,
     /// Landmarks found, once this panorama was fused, to mix rocks, and split.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub splits: Vec<SplitRecord>,
+}
+
+/// A held-back detection fused at a later station: detection `detection` (index into the
+/// station's detections) of station `station` is landmark `landmark`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LateSighting {
+    pub station: usize,
+    pub detection: usize,
+    pub landmark: LandmarkId,
 }
 
 /// A landmark whose sightings at two stations disagreed on where it is, split into the rocks

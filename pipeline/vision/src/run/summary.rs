@@ -29,9 +29,13 @@ pub struct RunSummary {
     /// Landmarks found to mix rocks and split after the fact (`association::audit`).
     #[serde(default)]
     pub landmarks_split: usize,
-    /// Observations held back at their station, resolved later, and still pending at the end.
+    /// Observations held back at their station, resolved later (re-tested on a tighter map,
+    /// or recognised at later stations: `association::recognition`), and still pending at the
+    /// end.
     pub held_back: usize,
     pub resolved_held_back: usize,
+    #[serde(default)]
+    pub recognised_held_back: usize,
     pub pending_held_back: usize,
     /// Held back and given up (waited too long, or their station had too few fused partners).
     pub expired_held_back: usize,
@@ -121,6 +125,7 @@ impl RunSummary {
                 .filter(|d| matches!(d.association, Association::HeldBack { .. }))
                 .count(),
             resolved_held_back: records.iter().map(|r| r.fusion.resolved_held_back).sum(),
+            recognised_held_back: records.iter().map(|r| r.fusion.recognised.len()).sum(),
             pending_held_back: mapper.held_back(),
             expired_held_back: mapper.expired,
             rng_certain: last.rng_certain,
@@ -177,11 +182,12 @@ impl fmt::Display for RunSummary {
         )?;
         writeln!(
             f,
-            "contradictions: {}; landmarks split: {}; held back: {} ({} resolved later, {} given up, {} pending)",
+            "contradictions: {}; landmarks split: {}; held back: {} ({} resolved by re-test, {} recognised at later stations, {} given up, {} pending)",
             self.contradictions,
             self.landmarks_split,
             self.held_back,
             self.resolved_held_back,
+            self.recognised_held_back,
             self.expired_held_back,
             self.pending_held_back
         )?;

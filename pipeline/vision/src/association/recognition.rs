@@ -1,0 +1,159 @@
+//! Held-back detections recognised at a later station (issue 13, item 3: association decided
+//! across stations rather than held and given up).
+//!
+//! A detection the map could not tell from its look-alikes is held back, and its placement
+//! stays in its station's frame as an unmapped rock. A later station that registers against
+//! that frame and anchors one of its own detections to a landmark, where the motion puts that
+//! detection on the unmapped rock and on nothing else, has seen the same rock twice: the
+//! held-back detection is that landmark. The anchor carries the identity (its appearance,
+//! several frames' agreement, the map's consistency test); the registration carries it back
+//! to the earlier station, by the same unambiguous-partner test that pairs a detection with
+//! a landmark ([`Registration::recognised`]).
+
+use super::placement::Placed;
+use super::registration::{Frame, Registration, MIN_INLIERS};
+use qrm_core::map::{LandmarkId, Sighting};
+
+/// An unmapped rock of a registered station's frame recognised as a landmark.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Recognition {
+    /// The frame, by index into the frames association registered against.
+    pub frame: usize,
+    /// The rock's placement among the frame's unmapped rocks.
+    pub unmapped: Placed,
+    /// The current station's detection (position in its view) anchored at the rock.
+    pub detection: usize,
+    pub landmark: LandmarkId,
+}
+
+/// The unmapped rocks of the registered station frames (not the sketch, whose unmapped rocks
+/// belong to no one station) recognised by the `anchored` detections: only under a motion
+/// whose pairs agree with the anchors (at least [`MIN_INLIERS`] of them anchored, none
+/// pairing an anchored detection or landmark otherwise), only for firm detections (a doubted
+/// one's placement is looser than it says), and not where the frame holds the landmark (its
+/// station mapped that rock already).
+pub fn recognitions(
+    frames: &[Frame],
+    registrations: &[(&Frame, Registration)],
+    placed: &[Option<Placed>],
+    doubtful: &[bool],
+    anchored: &[Sighting],
+) -> Vec<Recognition> {
+    let agrees = |r: &Registration| {
+        let anchor = |&(i, l): &(usize, LandmarkId)| {
+            anchored.iter().any(|a| a.position == i && a.landmark == l)
+        };
+        let conflicts = |&(i, l): &(usize, LandmarkId)| {
+            anchored
+                .iter()
+                .any(|a| (a.position == i) != (a.landmark == l))
+        };
+        r.pairs.iter().filter(|p| anchor(p)).count() >= MIN_INLIERS
+            && !r.pairs.iter().any(conflicts)
+    };
+    registrations
+        .iter()
+        .filter(|(frame, r)| !frame.accumulated && agrees(r))
+        .filter_map(|(frame, r)| {
+            let index = frames.iter().position(|f| std::ptr::eq(f, *frame))?;
+            Some((index, *frame, r))
+        })
+        .flat_map(|(index, frame, r)| {
+            anchored
+                .iter()
+                .filter(|a| !doubtful[a.position])
+                .filter(|a| !frame.landmarks.iter().any(|m| m.0 == a.landmark))
+                .filter_map(move |a| {
+                    let g = r.recognised(frame, placed, a.position)?;
+                    Some(Recognition {
+                        frame: index,
+                        unmapped: frame.unmapped[g],
+                        detection: a.position,
+                        landmark: a.landmark,
+                    })
+                })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::association::registration::tests::FIELD;
+
+    /// A station's frame: FIELD's first four rocks as landmarks 0‥3, and an unmapped rock (a
+    /// held-back detection) at FIELD's fifth.
+    fn frame() -> Frame {
+        Frame {
+            accumulated: false,
+            departed: Vec::new(),
+            unmapped: vec![Placed::disc(FIELD[4], 0.3)],
+            landmarks: (0..4)
+                .map(|k| (k as LandmarkId, Placed::disc(FIELD[k], 0.3)))
+                .collect(),
+        }
+    }
+
+    /// The current station, registered without motion: detections 0‥3 at the frame's
+    /// landmarks and anchored to them, detection 4 beside the unmapped rock anchored to
+    /// landmark 9, and the `extra` detections.
+    fn recognised(frames: &[Frame], extra: &[[f64; 2]], doubtful_4: bool) -> Vec<Recognition> {
+        let registration = Registration {
+            pairs: (0..4).map(|k| (k, k as LandmarkId)).collect(),
+            motion: [1.0, 0.0, 0.0, 0.0],
+            nfa: 0.0,
+        };
+        let mut points: Vec<[f64; 2]> = FIELD[..4].to_vec();
+        points.push([8.1, 8.0]);
+        points.extend(extra);
+        let placed: Vec<Option<Placed>> =
+            points.iter().map(|&p| Some(Placed::disc(p, 0.3))).collect();
+        let mut doubtful = vec![false; placed.len()];
+        doubtful[4] = doubtful_4;
+        let anchored: Vec<Sighting> = (0..4)
+            .map(|k| Sighting::new(k, k as LandmarkId))
+            .chain([Sighting::new(4, 9)])
+            .collect();
+        let registrations: Vec<(&Frame, Registration)> =
+            frames.iter().map(|f| (f, registration.clone())).collect();
+        recognitions(frames, &registrations, &placed, &doubtful, &anchored)
+    }
+
+    #[test]
+    fn an_anchor_at_an_unmapped_rock_recognises_it() {
+        let frames = [frame()];
+        assert_eq!(
+            recognised(&frames, &[], false),
+            [Recognition {
+                frame: 0,
+                unmapped: Placed::disc(FIELD[4], 0.3),
+                detection: 4,
+                landmark: 9,
+            }]
+        );
+    }
+
+    /// Another detection as near the rock, another unmapped rock as near the anchor, or a
+    /// doubted anchor: the rock may be another one, and nothing is recognised.
+    #[test]
+    fn a_rival_or_a_doubted_anchor_recognises_nothing() {
+        let frames = [frame()];
+        assert_eq!(recognised(&frames, &[[7.9, 8.0]], false), []);
+        assert_eq!(recognised(&frames, &[], true), []);
+        let mut crowded = frame();
+        crowded.unmapped.push(Placed::disc([8.3, 8.1], 0.3));
+        assert_eq!(recognised(&[crowded], &[], false), []);
+    }
+
+    /// The sketch's unmapped rocks belong to no one station, and a station that mapped the
+    /// landmark already saw its rock as that landmark.
+    #[test]
+    fn neither_the_sketch_nor_a_station_holding_the_landmark_recognises() {
+        let mut sketch = frame();
+        sketch.accumulated = true;
+        assert_eq!(recognised(&[sketch], &[], false), []);
+        let mut holding = frame();
+        holding.landmarks.push((9, Placed::disc([-6.0, -3.0], 0.3)));
+        assert_eq!(recognised(&[holding], &[], false), []);
+    }
+}
