@@ -956,6 +956,7 @@ mod tests {
             blob: 0,
             beyond_columns: [0, 0],
             parallax_shifts: None,
+            flat: false,
         }
     }
 

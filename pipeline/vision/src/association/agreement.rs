@@ -10,12 +10,16 @@
 //! (marsyard seed 3 at half resolution: landmark 9 took rock 16, 1.3 m from its own, at
 //! stations 23 and 25 through one 4-pair registration, 10 unsound relations).
 //!
+//! The audit asks the same of two stations' frames after the fact ([`witness`]), and also
+//! whether the motion puts one station's placement of the landmark on a rock the other
+//! station saw apart from it ([`taken_for_another`]).
+//!
 //! Leaving a match out loses a sighting, never soundness: the caller holds the detection back
 //! with the landmark as its only candidate, so it is fused later only as a new landmark, once
 //! the map rejects the match.
 
-use super::registration::{Frame, Motion};
-use super::Placed;
+use super::registration::{Frame, Motion, ANCHOR_RADIUS_M, SLACK_M, UNIQUE};
+use super::{placement, Placed};
 use qrm_core::map::LandmarkId;
 
 /// Fewest other shared landmarks that fix the motion between two stations.
@@ -57,15 +61,76 @@ fn shared(current: &[(LandmarkId, Placed)], frame: &Frame) -> Vec<(LandmarkId, (
 
 /// What the two stations' frames `a` and `b` say of landmark `l`, both placing it: `Some(true)`
 /// when the motion between them that at least [`FEWEST_OTHERS`] other shared landmarks agree
-/// on brings its two placements together, `Some(false)` when it does not, `None` when too few
-/// others are shared to say.
+/// on brings its two placements together, `Some(false)` when it does not, or when it brings
+/// one station's placement onto a rock the other station saw apart from the landmark
+/// ([`taken_for_another`]), `None` when too few others are shared to say.
 pub fn witness(a: &Frame, b: &Frame, l: LandmarkId) -> Option<bool> {
     let pairs = shared(&a.landmarks, b);
     let k = pairs.iter().position(|s| s.0 == l)?;
     let placements: Vec<(Placed, Placed)> = pairs.iter().map(|s| s.1).collect();
     let agree = Motion::agreed(&placements, FEWEST_OTHERS)?;
     let others = agree.iter().filter(|&&a| a).count() - usize::from(agree[k]);
-    (others >= FEWEST_OTHERS).then_some(agree[k])
+    if others < FEWEST_OTHERS {
+        return None;
+    }
+    if !agree[k] {
+        return Some(false);
+    }
+    let fitted: Vec<(Placed, Placed)> = (0..pairs.len())
+        .filter(|&j| j != k && agree[j])
+        .map(|j| placements[j])
+        .collect();
+    let swapped: Vec<(Placed, Placed)> = fitted.iter().map(|&(p, q)| (q, p)).collect();
+    let (p, q) = placements[k];
+    Some(
+        !taken_for_another(&Motion::fit(&fitted), &p, b, &q)
+            && !taken_for_another(&Motion::fit(&swapped), &q, a, &p),
+    )
+}
+
+/// Whether one station's placements `a` and `b` are of two rocks: apart by more than the
+/// registration's slack beyond their ellipses.
+fn apart(a: &Placed, b: &Placed) -> bool {
+    let separation = placement::separation(a, b, 0.0);
+    separation.distance > separation.gate + SLACK_M
+}
+
+/// Whether `motion` puts placement `p` of a landmark, unambiguously, on one of `frame`'s
+/// unmapped rocks (its held-back or given-up detections): that station saw a rock there
+/// [`apart`] from its own placement `own` of the landmark, and every other rock it places,
+/// the landmark's among them, lies clearly farther (the registration's unambiguous-partner
+/// test). Rocks closer together than their placements' tolerance pass the motion's test as
+/// one; a station that saw both apart tells them apart. JPEG marsyard seed 11: landmark 25
+/// took rocks 0.66 m apart (a blob holding both at station 35 joined them), while stations 22
+/// and 42 each saw the other rock beside it; grayscale marsyard seed 13: landmark 15, rocks
+/// 15 and 29. Without it the audit missed both, and the sightings later stations added to
+/// them made 2 and 3 unsound relations.
+fn taken_for_another(motion: &Motion, p: &Placed, frame: &Frame, own: &Placed) -> bool {
+    let separation = |q: &Placed| motion.separation(p, q);
+    let Some((u, nearest)) = frame
+        .unmapped
+        .iter()
+        .enumerate()
+        .filter(|(_, q)| q.reach() <= ANCHOR_RADIUS_M)
+        .map(|(u, q)| (u, separation(q)))
+        .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))
+    else {
+        return false;
+    };
+    let rivals = frame.landmarks.iter().map(|m| &m.1).chain(
+        frame
+            .unmapped
+            .iter()
+            .enumerate()
+            .filter(|&(o, _)| o != u)
+            .map(|(_, q)| q),
+    );
+    p.reach() <= ANCHOR_RADIUS_M
+        && nearest.within()
+        && apart(own, &frame.unmapped[u])
+        && rivals
+            .map(separation)
+            .all(|s| s.distance > UNIQUE * nearest.distance + SLACK_M)
 }
 
 #[cfg(test)]
@@ -171,6 +236,41 @@ mod tests {
              {rejected} stations rejected"
         );
         assert_eq!(drive_with_a_wrong_association(true), (0, 0));
+    }
+
+    /// Two stations placing ROCKS as landmarks without motion between them, tightly (0.2 m)
+    /// but for the second station's landmark 1, loose (0.6 m) and `offset` along x from the
+    /// first station's; the first station also saw a rock `beside` its landmark 1, along x.
+    fn beside(offset: f64, beside: Option<f64>) -> (Frame, Frame) {
+        let placed = |l: usize, p: [f64; 2], r: f64| (l as LandmarkId, Placed::disc(p, r));
+        let tight: Vec<(LandmarkId, Placed)> =
+            (0..ROCKS.len()).map(|l| placed(l, ROCKS[l], 0.2)).collect();
+        let mut a = frame(&[]);
+        a.landmarks = tight.clone();
+        a.unmapped = beside
+            .map(|x| Placed::disc([ROCKS[1][0] + x, ROCKS[1][1]], 0.2))
+            .into_iter()
+            .collect();
+        let mut b = frame(&[]);
+        b.landmarks = tight;
+        b.landmarks[1] = placed(1, [ROCKS[1][0] + offset, ROCKS[1][1]], 0.6);
+        (a, b)
+    }
+
+    /// The loose placement fits the landmark's tolerance, but lies on the rock the first
+    /// station saw a metre beside it: the stations saw two rocks as the landmark, whichever
+    /// frame is asked first.
+    #[test]
+    fn a_placement_on_a_rock_the_other_station_saw_apart_disagrees() {
+        let (a, b) = beside(0.9, None);
+        assert_eq!(witness(&a, &b, 1), Some(true));
+        let (a, b) = beside(0.9, Some(1.0));
+        assert_eq!(witness(&a, &b, 1), Some(false));
+        assert_eq!(witness(&b, &a, 1), Some(false));
+        // An unmapped rock the first station could not tell from its landmark (a piece of
+        // it) says nothing.
+        let (a, b) = beside(0.55, Some(0.6));
+        assert_eq!(witness(&a, &b, 1), Some(true));
     }
 
     #[test]

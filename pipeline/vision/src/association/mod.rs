@@ -171,6 +171,9 @@ pub struct Evidence {
     /// interval says: it observes landmarks, steers no registration, founds none, and anchors
     /// only as a far rock does, where every registered frame holding the landmark pairs it.
     pub doubtful: bool,
+    /// Nothing of it stands up from the ground by stereo ([`crate::detection::Detection::flat`]):
+    /// a soil patch or a shadow, or a rock too smooth to tell.
+    pub flat: bool,
     /// Rock pixels of the detection: too few ([`MIN_FOUNDING_PIXELS`]) describe no looks.
     pub pixels: u32,
 }
@@ -985,6 +988,7 @@ mod tests {
                 ray: toward(p),
                 piece: false,
                 doubtful: false,
+                flat: false,
                 pixels: 100,
             })
             .collect();

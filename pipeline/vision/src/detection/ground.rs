@@ -475,7 +475,7 @@ pub(super) fn nearest_face_shift(calib: &Calibration, bottom: f64, cut: bool) ->
 }
 
 /// The flat ground's stereo shift (columns) at image row `row`; 0 at and above the horizon.
-fn ground_shift(calib: &Calibration, row: f64) -> f64 {
+pub(super) fn ground_shift(calib: &Calibration, row: f64) -> f64 {
     calib.ground_range(row).map_or(0.0, |range| {
         calib.stereo_disparity(range) / calib.column_width()
     })

@@ -210,6 +210,12 @@ pub struct Detection {
     /// panorama's blob, holding both parts, cannot give.
     #[serde(default)]
     pub parallax_shifts: Option<[f64; 2]>,
+    /// By colour, with stereo: none of its pixels stands up from the ground by the stereo test
+    /// (`ground::GroundTest`: raised, or a smooth face nearer than the ground). A soil patch
+    /// or a cast shadow, or a rock too smooth to tell. False where untested: without stereo,
+    /// and by luminance, where every detection stands by construction.
+    #[serde(default)]
+    pub flat: bool,
 }
 
 /// Statistics that change little with viewpoint, for associating a rock across panoramas.
@@ -457,6 +463,22 @@ fn reach_beyond(
             r < rows && (test.stance(c, r) == ground::Stance::Raised || test.nearer(c, r, shift))
         })
     };
+    // A detection of which nothing stands is flat.
+    let flat: Vec<bool> = detections
+        .par_iter()
+        .map(|d| {
+            let pixels = &blobs[d.blob as usize];
+            let shift = max_shift(pixels, bands.top, rows, bands.calib);
+            let columns = d.bbox[0]..=d.bbox[2];
+            !pixels
+                .iter()
+                .filter(|p| columns.contains(&p.0))
+                .any(|&(c, r)| stands(i64::from(c), i64::from(r), shift))
+        })
+        .collect();
+    for (detection, flat) in detections.iter_mut().zip(flat) {
+        detection.flat = flat;
+    }
     let reach: std::collections::HashMap<u32, [u32; 2]> = detected_blobs(detections)
         .into_par_iter()
         .filter_map(|blob| {
@@ -813,6 +835,7 @@ fn accept(
         blob: 0,
         beyond_columns: [0, 0],
         parallax_shifts: None,
+        flat: false,
     })
 }
 
@@ -849,7 +872,7 @@ fn lies_flat(top_row: f64, range: f64, width_m: f64, calib: &Calibration, min_ri
 
 #[cfg(test)]
 mod tests {
-    use super::ground::Stance;
+    use super::ground::{self, Stance};
     use super::{
         between_raised, close3, ground_tint, lies_flat, Appearance, Channels, DetectorSettings,
     };
@@ -951,6 +974,72 @@ mod tests {
         for (settings, image, stereo, jpeg, mode) in cases {
             assert_eq!(settings.channels_of(image, stereo, jpeg), mode);
         }
+    }
+
+    /// A grey patch on textured soil, seen by a quarter-size stereo pair: painted on the
+    /// ground (the right panorama sees each of its rows at the ground's shift) nothing of it
+    /// stands and its detection is flat; as a rock's face (every row at its contact's shift)
+    /// it stands. Without stereo nothing is flat (untested).
+    #[test]
+    fn a_patch_on_the_ground_is_flat_and_a_standing_face_is_not() {
+        let calib = Calibration::parse(
+            "[image]\nwidth = 1024\nheight = 192\n[azimuth]\ncolumn0_deg = 180.0\n\
+             direction = \"clockwise\"\n[elevation]\nhorizon_row = 75.0\nfocal_px = 163.0\n\
+             [mast]\nheight_m = 1.5\n[stereo]\nbaseline_m = 0.3\n",
+            "test",
+        )
+        .expect("valid");
+        let (w, h) = (1024u32, 192u32);
+        let (rows, columns) = (95..120u32, 500.0..530.0);
+        // A level per whole pixel, from a hash of its column and row.
+        let level = |x: f64, y: u32| {
+            let mut k =
+                (x.floor() as i64 as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ u64::from(y) << 32;
+            k ^= k >> 29;
+            k = k.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            k ^= k >> 32;
+            0.9 + 0.2 * (k % 1000) as f32 / 1000.0
+        };
+        let contact = ground::ground_shift(&calib, f64::from(rows.end));
+        // The panorama whose columns see the world's columns shifted by `eye` (0 left, 1 right,
+        // the right camera seeing a point at a smaller column).
+        let pair = |standing: bool| {
+            let paint = |eye: f64| {
+                image::RgbImage::from_fn(w, h, |x, y| {
+                    let ground =
+                        f64::from(x) + eye * ground::ground_shift(&calib, f64::from(y) + 0.5);
+                    let face = if standing {
+                        f64::from(x) + eye * contact
+                    } else {
+                        ground
+                    };
+                    let (base, at) = if rows.contains(&y) && columns.contains(&face) {
+                        ([120.0, 110.0, 100.0], face)
+                    } else {
+                        ([180.0, 110.0, 70.0], ground)
+                    };
+                    let t = level(at, y);
+                    image::Rgb(base.map(|c: f32| (c * t).min(255.0) as u8))
+                })
+            };
+            (paint(0.0), paint(1.0))
+        };
+        let colour = DetectorSettings {
+            channels: Channels::Colour,
+            ..DetectorSettings::default()
+        };
+        let patch = |left: &image::RgbImage, right: Option<&image::RgbImage>, settings| {
+            let found = super::detect(left, right, &calib, settings);
+            found
+                .into_iter()
+                .find(|d| d.bbox[0] < 530 && d.bbox[2] >= 500 && d.bbox[1] < 120 && d.bbox[3] >= 95)
+                .unwrap_or_else(|| panic!("the patch is detected"))
+        };
+        let (left, right) = pair(false);
+        assert!(patch(&left, Some(&right), &colour).flat);
+        assert!(!patch(&left, None, &colour).flat);
+        let (left, right) = pair(true);
+        assert!(!patch(&left, Some(&right), &colour).flat);
     }
 
     /// A one-pixel crack inside a blob is bridged; the blob does not grow, even at the edge.

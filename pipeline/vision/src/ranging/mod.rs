@@ -557,6 +557,7 @@ mod tests {
             blob: 7,
             beyond_columns: [0, 0],
             parallax_shifts: None,
+            flat: false,
         }
     }
 

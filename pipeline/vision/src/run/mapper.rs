@@ -387,9 +387,10 @@ impl<C: Calculus> Mapper<C> {
     /// Counts the recognitions of held-back observations by this station's anchors
     /// ([`Recognition`], with the station of its frame): of the observation held at that
     /// station and placed at the recognised rock, when the landmark is among its candidates
-    /// (its looks and the map allowed it) and no other detection of that station took it. An
-    /// observation that [`RECOGNITIONS`] stations recognised, all as one landmark, is fused
-    /// as that landmark.
+    /// (its looks and the map allowed it), no other detection of that station took it, and it
+    /// is not flat ([`Evidence::flat`]: a soil patch or shadow beside the rock is placed where
+    /// the rock is). An observation that [`RECOGNITIONS`] stations recognised, all as one
+    /// landmark, is fused as that landmark.
     fn fuse_recognised(
         &mut self,
         record: &mut StationRecord,
@@ -401,6 +402,7 @@ impl<C: Calculus> Mapper<C> {
             let Some(k) = held.iter().position(|item| {
                 item.station == *station
                     && item.evidence.placed == Some(recognition.unmapped)
+                    && !item.evidence.flat
                     && item.candidates.contains(&landmark)
                     && !item.decided.iter().any(|d| d.landmark == landmark)
             }) else {
@@ -1044,6 +1046,7 @@ mod tests {
                 },
                 piece: false,
                 doubtful: false,
+                flat: false,
                 pixels: 100,
             },
             recognised: Vec::new(),
@@ -1104,6 +1107,22 @@ mod tests {
         assert_eq!(mapper.sighted[2].frame.landmarks[k - 1], (15, at));
         assert!(mapper.sighted[2].frame.unmapped.is_empty());
         assert_eq!(unsound(&mapper.map, |l| l as usize), 0);
+    }
+
+    /// A flat detection (nothing of it stands up by stereo) may be a soil patch beside the
+    /// rock: recognised twice, it stays held (the 1 000-rock drive, station 97: a 24 × 5 px
+    /// box that meets no rock, recognised as landmark 316, made 8 unsound relations).
+    #[test]
+    fn a_flat_held_back_observation_is_not_fused_on_recognitions() {
+        let mut mapper = test_mapper();
+        let at = held_at_station_2(&mut mapper);
+        mapper.held[0].evidence.flat = true;
+        recognise(&mut mapper, 3, at, 15);
+        assert!(recognise(&mut mapper, 4, at, 15)
+            .fusion
+            .recognised
+            .is_empty());
+        assert_eq!(mapper.held_back(), 1);
     }
 
     /// Two stations that recognise the observation as different landmarks leave it held.

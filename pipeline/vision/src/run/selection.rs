@@ -134,6 +134,7 @@ pub(crate) fn station_evidence(
                 ray: ranged[i].ray,
                 piece: ranged[i].piece,
                 doubtful: observes(station, ranged, i),
+                flat: station.primary[i].flat,
                 pixels: station.primary[i].pixels,
             })
             .collect(),
@@ -215,6 +216,7 @@ mod tests {
             blob: 0,
             beyond_columns: [0, 0],
             parallax_shifts: None,
+            flat: false,
         }
     }
 
