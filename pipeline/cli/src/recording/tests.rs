@@ -43,6 +43,7 @@ fn station(index: usize) -> StationRecord {
                 centroid: [f64::from(column) + 30.0, 360.0],
                 contact_row: 420.0,
                 contact_slack_rows: 0.0,
+                flat: false,
                 pixels: 5000 + k as u32,
                 stereo_column: (k % 2 == 0).then_some(f64::from(column) + 22.5),
                 bearing: k as f64 * 1.5 - 3.0,

@@ -413,10 +413,11 @@ fn detect_in(
             Some(detection)
         })
         .collect();
-    // In colour mode, how far each detected blob's rock may reach beyond what the colour test
-    // found: by stereo, and by faint colour.
+    // In colour mode, whether anything of each detection stands up from the ground, and how
+    // far each detected blob's rock may reach beyond what the colour test found: by stereo,
+    // and by faint colour.
     if let Some(bands) = ground_bands.filter(|_| !luminance) {
-        reach_beyond(&mut detections, &blobs, mask.as_slice(), bands);
+        apply_ground_test(&mut detections, &blobs, mask.as_slice(), bands);
     }
     // (Only for the primary panorama: a right one's detections serve the stereo cue alone.)
     if !luminance && !matches!(other, Some((_, Eye::Left))) {
@@ -432,12 +433,13 @@ fn detect_in(
     detections
 }
 
-/// Sets each detection's [`Detection::beyond_columns`]: the pixels standing up from the
-/// ground (`ground::GroundTest`: raised, or a smooth face nearer than the ground) that join
-/// its blob (`blobs`, components of the colour test's `mask`, as wide as the bands) beside
-/// it, on the sides where it ends the blob. The stereo test of `bands` runs over the tiles
-/// the searches visit only; blobs are searched in parallel.
-fn reach_beyond(
+/// Sets each detection's [`Detection::flat`] (none of its blob's pixels within its columns
+/// stands up from the ground: `ground::GroundTest`, raised or a smooth face nearer than the
+/// ground) and [`Detection::beyond_columns`]: the standing pixels that join its blob
+/// (`blobs`, components of the colour test's `mask`, as wide as the bands) beside it, on the
+/// sides where it ends the blob. The stereo test of `bands` runs over the tiles the
+/// detections and searches visit only; detections and blobs are tested in parallel.
+fn apply_ground_test(
     detections: &mut [Detection],
     blobs: &[components::Component],
     mask: &[u8],
@@ -463,7 +465,6 @@ fn reach_beyond(
             r < rows && (test.stance(c, r) == ground::Stance::Raised || test.nearer(c, r, shift))
         })
     };
-    // A detection of which nothing stands is flat.
     let flat: Vec<bool> = detections
         .par_iter()
         .map(|d| {

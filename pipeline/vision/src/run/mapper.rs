@@ -830,6 +830,7 @@ fn detection_record(d: &Detection, r: &Ranged) -> DetectionRecord {
         contact_row: d.contact_row,
         contact_slack_rows: d.contact_slack_rows,
         pixels: d.pixels,
+        flat: d.flat,
         stereo_column: r.stereo_column,
         bearing: r.bearing.angle,
         bearing_uncertainty: r.bearing.uncertainty,

@@ -51,6 +51,10 @@ pub struct DetectionRecord {
     #[serde(default)]
     pub contact_slack_rows: f64,
     pub pixels: u32,
+    /// By colour with stereo, nothing of it stands up from the ground
+    /// ([`crate::detection::Detection::flat`]): never fused on later stations' recognitions.
+    #[serde(default)]
+    pub flat: bool,
     /// Centroid column of the matched detection in the right panorama, if any.
     pub stereo_column: Option<f64>,
     /// Bearing from the station centre, radians counter-clockwise from the calibration's zero.
