@@ -18,7 +18,7 @@
 //! with the landmark as its only candidate, so it is fused later only as a new landmark, once
 //! the map rejects the match.
 
-use super::registration::{Frame, Motion, ANCHOR_RADIUS_M, SLACK_M, UNIQUE};
+use super::registration::{unmapped_partner, Frame, Motion, SLACK_M};
 use super::{placement, Placed};
 use qrm_core::map::LandmarkId;
 
@@ -96,41 +96,16 @@ fn apart(a: &Placed, b: &Placed) -> bool {
 }
 
 /// Whether `motion` puts placement `p` of a landmark, unambiguously, on one of `frame`'s
-/// unmapped rocks (its held-back or given-up detections): that station saw a rock there
-/// [`apart`] from its own placement `own` of the landmark, and every other rock it places,
-/// the landmark's among them, lies clearly farther (the registration's unambiguous-partner
-/// test). Rocks closer together than their placements' tolerance pass the motion's test as
-/// one; a station that saw both apart tells them apart. JPEG marsyard seed 11: landmark 25
-/// took rocks 0.66 m apart (a blob holding both at station 35 joined them), while stations 22
-/// and 42 each saw the other rock beside it; grayscale marsyard seed 13: landmark 15, rocks
-/// 15 and 29. Without it the audit missed both, and the sightings later stations added to
-/// them made 2 and 3 unsound relations.
+/// unmapped rocks (its held-back or given-up detections: [`unmapped_partner`], every other
+/// rock the frame places, the landmark's among them, clearly farther) that its station saw
+/// [`apart`] from its own placement `own` of the landmark. Rocks closer together than their
+/// placements' tolerance pass the motion's test as one; a station that saw both apart tells
+/// them apart. JPEG marsyard seed 11: landmark 25 took rocks 0.66 m apart (a blob holding both
+/// at station 35 joined them), while stations 22 and 42 each saw the other rock beside it;
+/// grayscale marsyard seed 13: landmark 15, rocks 15 and 29. Without it the audit missed both,
+/// and the sightings later stations added to them made 2 and 3 unsound relations.
 fn taken_for_another(motion: &Motion, p: &Placed, frame: &Frame, own: &Placed) -> bool {
-    let separation = |q: &Placed| motion.separation(p, q);
-    let Some((u, nearest)) = frame
-        .unmapped
-        .iter()
-        .enumerate()
-        .filter(|(_, q)| q.reach() <= ANCHOR_RADIUS_M)
-        .map(|(u, q)| (u, separation(q)))
-        .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))
-    else {
-        return false;
-    };
-    let rivals = frame.landmarks.iter().map(|m| &m.1).chain(
-        frame
-            .unmapped
-            .iter()
-            .enumerate()
-            .filter(|&(o, _)| o != u)
-            .map(|(_, q)| q),
-    );
-    p.reach() <= ANCHOR_RADIUS_M
-        && nearest.within()
-        && apart(own, &frame.unmapped[u])
-        && rivals
-            .map(separation)
-            .all(|s| s.distance > UNIQUE * nearest.distance + SLACK_M)
+    unmapped_partner(motion, p, frame).is_some_and(|u| apart(own, &frame.unmapped[u]))
 }
 
 #[cfg(test)]

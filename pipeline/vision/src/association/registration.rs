@@ -66,7 +66,7 @@ pub struct Registration {
 /// Slack added to every distance comparison, metres (rock reference points are not points).
 pub(super) const SLACK_M: f64 = 0.3;
 /// A partner is unambiguous when every rival lies this many times farther (plus the slack).
-pub(super) const UNIQUE: f64 = 2.0;
+const UNIQUE: f64 = 2.0;
 /// How much better (in fit score) the best motion must be than any different one.
 const MARGIN: f64 = 1.5;
 /// Loosest placement of a detection that anchors on the usual terms, metres: a looser one (a far
@@ -659,38 +659,21 @@ impl Registration {
     }
 
     /// The frame's unmapped rock (index into [`Frame::unmapped`]) that the current station's
-    /// detection `i` is, by the fit's own test of an unambiguous partner: both placed no looser
-    /// than an anchor ([`ANCHOR_RADIUS_M`]), within the pair's separation, every landmark and
-    /// every other unmapped rock of the frame clearly farther from the detection, and every
-    /// other placed detection of the station clearly farther from the rock.
+    /// detection `i` is ([`unmapped_partner`]), when every other placed detection of the
+    /// station lies clearly farther from the rock.
     pub fn recognised(&self, frame: &Frame, current: &[Option<Placed>], i: usize) -> Option<usize> {
         let motion = self.motion();
-        let p = current[i].filter(|p| p.reach() <= ANCHOR_RADIUS_M)?;
-        let (g, separation) = frame
-            .unmapped
+        let p = current[i]?;
+        let g = unmapped_partner(&motion, &p, frame)?;
+        let q = frame.unmapped[g];
+        let near = UNIQUE * motion.separation(&p, &q).distance + SLACK_M;
+        current
             .iter()
             .enumerate()
-            .map(|(g, q)| (g, motion.separation(&p, q)))
-            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))?;
-        let q = frame.unmapped[g];
-        let near = UNIQUE * separation.distance + SLACK_M;
-        let alone = frame
-            .landmarks
-            .iter()
-            .map(|m| &m.1)
-            .chain(
-                frame
-                    .unmapped
-                    .iter()
-                    .enumerate()
-                    .filter(|&(k, _)| k != g)
-                    .map(|(_, o)| o),
-            )
-            .all(|o| motion.separation(&p, o).distance > near);
-        let unrivalled = current.iter().enumerate().all(|(k, other)| {
-            k == i || other.is_none_or(|o| motion.separation(&o, &q).distance > near)
-        });
-        (separation.within() && q.reach() <= ANCHOR_RADIUS_M && alone && unrivalled).then_some(g)
+            .all(|(k, other)| {
+                k == i || other.is_none_or(|o| motion.separation(&o, &q).distance > near)
+            })
+            .then_some(g)
     }
 
     /// Where the current station's point `p` lies in the frame's coordinates.
@@ -711,6 +694,37 @@ impl Registration {
             shift: [x, y],
         }
     }
+}
+
+/// The unmapped rock of `frame` (index into [`Frame::unmapped`]) that `motion` puts the
+/// placement `p` on, by the fit's own test of an unambiguous partner: both placed no looser
+/// than an anchor ([`ANCHOR_RADIUS_M`]), within the pair's separation, and every landmark and
+/// every other unmapped rock of the frame clearly farther from `p`.
+pub(super) fn unmapped_partner(motion: &Motion, p: &Placed, frame: &Frame) -> Option<usize> {
+    if p.reach() > ANCHOR_RADIUS_M {
+        return None;
+    }
+    let (g, separation) = frame
+        .unmapped
+        .iter()
+        .enumerate()
+        .map(|(g, q)| (g, motion.separation(p, q)))
+        .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))?;
+    let near = UNIQUE * separation.distance + SLACK_M;
+    let alone = frame
+        .landmarks
+        .iter()
+        .map(|m| &m.1)
+        .chain(
+            frame
+                .unmapped
+                .iter()
+                .enumerate()
+                .filter(|&(k, _)| k != g)
+                .map(|(_, o)| o),
+        )
+        .all(|o| motion.separation(p, o).distance > near);
+    (separation.within() && frame.unmapped[g].reach() <= ANCHOR_RADIUS_M && alone).then_some(g)
 }
 
 /// The displacement from an `earlier` station to a `later` one, seen from the earlier camera:
