@@ -1110,42 +1110,34 @@ mod tests {
         assert_eq!(unsound(&mapper.map, |l| l as usize), 0);
     }
 
-    /// A flat detection (nothing of it stands up by stereo) may be a soil patch beside the
-    /// rock: recognised twice, it stays held (the 1 000-rock drive, station 97: a 24 × 5 px
-    /// box that meets no rock, recognised as landmark 316, made 8 unsound relations).
-    #[test]
-    fn a_flat_held_back_observation_is_not_fused_on_recognitions() {
+    /// Stations 3 and 4 recognise the observation held at station 2 (flat or not) as `first`
+    /// and `second`: nothing is fused, and it stays held.
+    fn assert_stays_held(flat: bool, first: LandmarkId, second: LandmarkId) {
         let mut mapper = test_mapper();
         let at = held_at_station_2(&mut mapper);
-        mapper.held[0].evidence.flat = true;
-        recognise(&mut mapper, 3, at, 15);
-        assert!(recognise(&mut mapper, 4, at, 15)
+        mapper.held[0].evidence.flat = flat;
+        recognise(&mut mapper, 3, at, first);
+        assert!(recognise(&mut mapper, 4, at, second)
             .fusion
             .recognised
             .is_empty());
         assert_eq!(mapper.held_back(), 1);
     }
 
-    /// Two stations that recognise the observation as different landmarks leave it held.
+    /// A flat detection (nothing of it stands up by stereo) may be a soil patch beside the
+    /// rock: recognised twice, it stays held (the 1 000-rock drive, station 97: a 24 × 5 px
+    /// box that meets no rock, recognised as landmark 316, made 8 unsound relations).
+    #[test]
+    fn a_flat_held_back_observation_is_not_fused_on_recognitions() {
+        assert_stays_held(true, 15, 15);
+    }
+
+    /// Two stations that recognise the observation as different landmarks leave it held, nor
+    /// does a landmark the observation was not a candidate for count.
     #[test]
     fn recognitions_as_different_landmarks_fuse_nothing() {
-        let mut mapper = test_mapper();
-        let at = held_at_station_2(&mut mapper);
-        recognise(&mut mapper, 3, at, 15);
-        assert!(recognise(&mut mapper, 4, at, 3)
-            .fusion
-            .recognised
-            .is_empty());
-        assert_eq!(mapper.held_back(), 1);
-        // Nor does a landmark the observation was not a candidate for count.
-        let mut mapper = test_mapper();
-        let at = held_at_station_2(&mut mapper);
-        recognise(&mut mapper, 3, at, 15);
-        assert!(recognise(&mut mapper, 4, at, 7)
-            .fusion
-            .recognised
-            .is_empty());
-        assert_eq!(mapper.held_back(), 1);
+        assert_stays_held(false, 15, 3);
+        assert_stays_held(false, 15, 7);
     }
 
     #[test]
