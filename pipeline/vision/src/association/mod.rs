@@ -1009,6 +1009,7 @@ mod tests {
         Ray {
             azimuth: p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU),
             half_baseline: 0.0,
+            nearest: 0.0,
         }
     }
 

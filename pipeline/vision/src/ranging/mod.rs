@@ -84,6 +84,9 @@ pub struct Ray {
     pub azimuth: f64,
     /// Half the baseline (metres) when seen by the left eye alone, else 0.
     pub half_baseline: f64,
+    /// Least range (metres from the centre) its rock can lie at ([`nearest`]): the ray starts
+    /// there. 0 when the panorama bounds nothing.
+    pub nearest: f64,
 }
 
 impl Ray {
@@ -92,6 +95,7 @@ impl Ray {
         Ray {
             azimuth: azimuth.rem_euclid(TAU),
             half_baseline: 0.0,
+            nearest: 0.0,
         }
     }
 
@@ -187,7 +191,10 @@ pub fn observe(
             });
             Ranged {
                 bearing,
-                ray,
+                ray: Ray {
+                    nearest: nearest(i, primary, fused, calib, model),
+                    ..ray
+                },
                 piece,
                 stereo_column: right_detection.map(|r| r.centroid[0]),
                 angular_width,
@@ -377,19 +384,72 @@ fn neighbour_reach(index: usize, all: &[Detection], width: u32) -> [u32; 2] {
 /// away, was ranged at 26–33 m, 147 unsound relations; over 9 sets such detections' ground
 /// cues missed their rock 30 times in 32).
 fn contact_hidden(index: usize, all: &[Detection], width: u32, model: &SensorModel) -> bool {
+    hiders(index, all, width, model).next().is_some()
+}
+
+/// The detections that may hide detection `index`'s contact ([`contact_hidden`]).
+fn hiders<'a>(
+    index: usize,
+    all: &'a [Detection],
+    width: u32,
+    model: &SensorModel,
+) -> impl Iterator<Item = usize> + 'a {
     let me = &all[index];
     let flat = f64::from(me.bbox[3] - me.bbox[1] + 1) <= 2.0 * model.contact_error_px;
-    all.iter().enumerate().any(|(j, other)| {
+    all.iter().enumerate().filter_map(move |(j, other)| {
         let reach = if flat {
             MIN_CONTACT_GAP_ROWS.max(0.25 * f64::from(other.bbox[3] - other.bbox[1] + 1))
         } else {
             MIN_CONTACT_GAP_ROWS
         };
-        j != index
+        (j != index
             && columns_overlap(me.bbox, other.bbox, 2, width)
             && other.contact_row > me.contact_row
-            && f64::from(other.bbox[1]) <= me.contact_row + reach
+            && f64::from(other.bbox[1]) <= me.contact_row + reach)
+            .then_some(j)
     })
+}
+
+/// The least range from the centre at which detection `index`'s rock can lie: its range
+/// interval's near end when a cue bounds it, else, when nearer detections may hide its contact
+/// ([`contact_hidden`]), the flat-ground range from the eye (no more than from the centre) of
+/// the lowest contact among them and the detections hiding theirs in turn (a hidden contact
+/// lies behind them, so no lower in the image); 0 when one of those is cut off by the image's
+/// bottom edge, or when nothing bounds it.
+/// An unranged detection so bounded is no rock nearer than that (`association`: a landmark
+/// the rover's motion brings nearer is not that rock).
+fn nearest(
+    index: usize,
+    all: &[Detection],
+    fused: RangeInterval,
+    calib: &Calibration,
+    model: &SensorModel,
+) -> f64 {
+    if fused.low > 0.0 {
+        return fused.low;
+    }
+    let width = calib.image.width;
+    let mut behind = vec![false; all.len()];
+    behind[index] = true;
+    let mut frontier = vec![index];
+    let mut lowest: Option<f64> = None;
+    while let Some(k) = frontier.pop() {
+        for j in hiders(k, all, width, model).collect::<Vec<_>>() {
+            if !behind[j] {
+                behind[j] = true;
+                let other = &all[j];
+                if other.bbox[3] + 1 >= calib.image.height {
+                    return 0.0;
+                }
+                let contact = other.contact_row + other.contact_slack_rows;
+                lowest = Some(lowest.map_or(contact, |l: f64| l.max(contact)));
+                frontier.push(j);
+            }
+        }
+    }
+    lowest
+        .and_then(|row| calib.ground_range(row + model.contact_error_px))
+        .unwrap_or(0.0)
 }
 
 /// Rows below a contact within which a nearer detection's top hides it.
@@ -486,6 +546,7 @@ fn bearing_of(
             let eye = Ray {
                 azimuth: (left + shift).rem_euclid(TAU),
                 half_baseline,
+                nearest: 0.0,
             };
             let (small, large) = (eye.offset_at(range.high), eye.offset_at(range.low));
             (left + 0.5 * (small + large), 0.5 * (large - small), eye)
@@ -622,6 +683,38 @@ mod tests {
             !contact_hidden(0, &[aside, low], width, &model),
             "ground shows between the strip and the rock below"
         );
+    }
+
+    /// A rock whose contact a nearer rock hides lies behind it: no nearer than the flat-ground
+    /// range of the hider's contact, or of the contact of a rock hiding the hider's in turn.
+    /// A hider cut off by the image's bottom edge bounds nothing, and nor does a detection
+    /// nothing hides; one a cue ranges starts at its interval's near end.
+    #[test]
+    fn a_rock_behind_a_nearer_one_lies_no_nearer_than_the_nearer_ones_contact() {
+        let calib = half_resolution_stereo();
+        let model = SensorModel::default();
+        let unranged = RangeInterval::unbounded();
+        let far = blob([400, 170, 440, 185], Separation::Whole);
+        let hider = blob([420, 186, 470, 215], Separation::Whole);
+        let ground = |row: f64| calib.ground_range(row + model.contact_error_px).unwrap();
+        let behind = nearest(0, &[far.clone(), hider.clone()], unranged, &calib, &model);
+        assert_eq!(behind, ground(216.0));
+        assert!(behind > 3.0 && behind < ground(186.0), "{behind}");
+        let under = blob([430, 214, 480, 260], Separation::Whole);
+        let chain = [far.clone(), hider.clone(), under.clone()];
+        assert_eq!(nearest(0, &chain, unranged, &calib, &model), ground(261.0));
+        let cut = blob([430, 214, 480, 383], Separation::Whole);
+        assert_eq!(
+            nearest(0, &[far.clone(), hider, cut], unranged, &calib, &model),
+            0.0
+        );
+        let beside = blob([500, 186, 520, 215], Separation::Whole);
+        assert_eq!(
+            nearest(0, &[far.clone(), beside], unranged, &calib, &model),
+            0.0
+        );
+        let ranged = RangeInterval::new(6.0, 9.0);
+        assert_eq!(nearest(0, &[far, under], ranged, &calib, &model), 6.0);
     }
 
     /// The left eye alone, without a range: the bearing interval runs from the eye's direction
@@ -838,6 +931,7 @@ mod tests {
                     ray: Ray {
                         azimuth: 0.0,
                         half_baseline: 0.0,
+                        nearest: 0.0,
                     },
                     stereo_column: None,
                     angular_width: 0.01,

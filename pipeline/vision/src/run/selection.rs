@@ -229,6 +229,7 @@ mod tests {
             ray: Ray {
                 azimuth: 1.0,
                 half_baseline: 0.0,
+                nearest: 0.0,
             },
             stereo_column: None,
             angular_width: 0.01,
