@@ -415,9 +415,8 @@ fn hiders<'a>(
 /// ([`contact_hidden`]), the flat-ground range from the eye (no more than from the centre) of
 /// the lowest contact among them and the detections hiding theirs in turn (a hidden contact
 /// lies behind them, so no lower in the image); 0 when one of those is cut off by the image's
-/// bottom edge, or when nothing bounds it.
-/// An unranged detection so bounded is no rock nearer than that (`association`: a landmark
-/// the rover's motion brings nearer is not that rock).
+/// bottom edge, or when nothing bounds it. Association uses it to tell that a landmark the
+/// motion brings nearer than that is not this detection's rock.
 fn nearest(
     index: usize,
     all: &[Detection],
@@ -434,7 +433,7 @@ fn nearest(
     let mut frontier = vec![index];
     let mut lowest: Option<f64> = None;
     while let Some(k) = frontier.pop() {
-        for j in hiders(k, all, width, model).collect::<Vec<_>>() {
+        for j in hiders(k, all, width, model) {
             if !behind[j] {
                 behind[j] = true;
                 let other = &all[j];
