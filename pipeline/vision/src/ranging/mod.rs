@@ -301,11 +301,10 @@ fn ground_cue(
     angular_width: f64,
     half_baseline: f64,
 ) -> Option<RangeInterval> {
-    // Cut off by the bottom edge: the contact is not in the picture.
-    if d.bbox[3] + 1 >= calib.image.height || contact_hidden(index, all, calib.image.width, model) {
+    if cut_off(d, calib) || contact_hidden(index, all, calib.image.width, model) {
         return None;
     }
-    let near = calib.ground_range(d.contact_row + d.contact_slack_rows + model.contact_error_px)?;
+    let near = contact_near(d, calib, model)?;
     let far = calib.ground_range(d.contact_row - model.contact_error_px)?;
     // Range from the eye along the view, then from the station centre (the eye sits half a
     // baseline across the view).
@@ -314,6 +313,18 @@ fn ground_cue(
         centre(near),
         beyond_reach(centre(far), model, angular_width)?,
     ))
+}
+
+/// Whether `d` reaches the image's bottom edge: its contact is not in the picture.
+fn cut_off(d: &Detection, calib: &Calibration) -> bool {
+    d.bbox[3] + 1 >= calib.image.height
+}
+
+/// The flat-ground range from the eye of the lowest row `d`'s contact may lie at (its
+/// contact row, the slack its shape allows and the contact's error): the near end of its
+/// ground cue. `None` at or above the horizon.
+fn contact_near(d: &Detection, calib: &Calibration, model: &SensorModel) -> Option<f64> {
+    calib.ground_range(d.contact_row + d.contact_slack_rows + model.contact_error_px)
 }
 
 /// The far end of a cue for the rock's reference point, which lies beyond the visible
@@ -431,24 +442,22 @@ fn nearest(
     let mut behind = vec![false; all.len()];
     behind[index] = true;
     let mut frontier = vec![index];
-    let mut lowest: Option<f64> = None;
+    let mut least: Option<f64> = None;
     while let Some(k) = frontier.pop() {
         for j in hiders(k, all, width, model) {
             if !behind[j] {
                 behind[j] = true;
-                let other = &all[j];
-                if other.bbox[3] + 1 >= calib.image.height {
+                if cut_off(&all[j], calib) {
                     return 0.0;
                 }
-                let contact = other.contact_row + other.contact_slack_rows;
-                lowest = Some(lowest.map_or(contact, |l: f64| l.max(contact)));
+                if let Some(near) = contact_near(&all[j], calib, model) {
+                    least = Some(least.map_or(near, |l: f64| l.min(near)));
+                }
                 frontier.push(j);
             }
         }
     }
-    lowest
-        .and_then(|row| calib.ground_range(row + model.contact_error_px))
-        .unwrap_or(0.0)
+    least.unwrap_or(0.0)
 }
 
 /// Rows below a contact within which a nearer detection's top hides it.
