@@ -156,20 +156,28 @@ fn width_of(d: &Detection, ranged: &Ranged, model: &SensorModel) -> Option<Range
 }
 
 /// A detection's rough position around the station, if its range is bounded well enough to
-/// place it: the middle of its range interval along its bearing.
+/// place it ([`placement`]).
 fn placed(r: &Ranged) -> Option<Placed> {
     placement(r.bearing.angle, r.bearing.uncertainty, r.fused.as_array())
 }
 
 /// The rough position of a rock at `bearing` (± `uncertainty`) and range in `[low, high]`
-/// metres: the middle of the interval along the bearing, in an ellipse reaching over the
-/// interval along the bearing and over the bearing error at the far end across it; none when
-/// the range is unbounded or wider than its middle.
+/// metres, in an ellipse as long along the bearing as the interval and as wide across it as
+/// the bearing error at the far end; none when the range is unbounded or wider than its middle.
+///
+/// It is centred at the interval's middle in inverse range, `2·low·high / (low + high)`, not
+/// in metres. Both range cues measure in inverse range: a stereo disparity, and a contact
+/// row's offset below the horizon. Their error bounds are symmetric there, so the measured
+/// range lies at that centre, nearer than the interval's metric middle. Over 18 preset
+/// renderings (colour, luminance, JPEG, stress) a placed detection's true range lay within
+/// 1.9 % of that centre (median; 7.5 % for nine in ten) against 2.8 % (11.1 %) of the metric
+/// middle, and one ranged by stereo alone within 4.3 % against 7.8 % (docs/RUN.md, stop 63).
 pub(crate) fn placement(bearing: f64, uncertainty: f64, [low, high]: [f64; 2]) -> Option<Placed> {
     let middle = 0.5 * (low + high);
     (high.is_finite() && high - low < middle).then(|| {
+        let centre = low * high / middle;
         Placed::along(
-            [middle * bearing.cos(), middle * bearing.sin()],
+            [centre * bearing.cos(), centre * bearing.sin()],
             bearing,
             0.5 * (high - low),
             high * uncertainty,
@@ -192,6 +200,7 @@ pub(super) fn view_of(ranged: &[Ranged], usable: &[usize]) -> StationView {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::calib::Calibration;
     use crate::detection::Appearance;
     use crate::ranging::{PrimaryEye, Ray};
 
@@ -322,5 +331,50 @@ mod tests {
         // Localization leaves the observers out.
         assert_eq!(usable_firm(&colour, &all, 4096), [0, 1, 5, 6]);
         assert_eq!(usable_firm(&luminance, &all, 4096), [0, 1]);
+    }
+
+    /// The marsyard calibration (4096 × 768, horizon at row 300, 1.5 m mast, 0.3 m baseline).
+    fn marsyard() -> Calibration {
+        let text = "[image]\nwidth = 4096\nheight = 768\n[azimuth]\ncolumn0_deg = 180.0\n\
+            direction = \"clockwise\"\n[elevation]\nhorizon_row = 300.0\nfocal_px = 652.0\n\
+            [mast]\nheight_m = 1.5\n[stereo]\nbaseline_m = 0.3\n";
+        Calibration::parse(text, "test").expect("valid")
+    }
+
+    /// How far from the station a placement's centre lies.
+    fn centre_range(placed: &Placed) -> f64 {
+        placed.point[0].hypot(placed.point[1])
+    }
+
+    proptest::proptest! {
+        /// A range interval bounded by a symmetric error on a measurement linear in inverse
+        /// range is placed at the measured range, nearer than the interval's metric middle:
+        /// exactly for a contact row `±k` rows, and to the sine's curvature for a disparity
+        /// `±e` columns. The ellipse's length along the bearing is the interval's.
+        #[test]
+        fn a_placement_is_centred_where_the_cue_measured_the_range(
+            range in 1.0f64..15.0,
+            rows in 0.5f64..8.0,
+            columns in 0.5f64..8.0,
+            bearing in 0.0f64..std::f64::consts::TAU,
+        ) {
+            let calib = marsyard();
+            let row = calib.ground_row(range);
+            let ground = [calib.ground_range(row + rows), calib.ground_range(row - rows)];
+            let disparity = calib.stereo_disparity(range);
+            let error = columns * calib.column_width();
+            let stereo = [
+                calib.stereo_range(disparity + error),
+                calib.stereo_range(disparity - error),
+            ];
+            for (cue, tolerance) in [(ground, 1e-9), (stereo, 1e-3)] {
+                let [Some(low), Some(high)] = cue else { continue };
+                let Some(placed) = placement(bearing, 0.01, [low, high]) else { continue };
+                proptest::prop_assert!((centre_range(&placed) - range).abs() <= tolerance * range);
+                proptest::prop_assert!(centre_range(&placed) < 0.5 * (low + high));
+                let direction = [bearing.cos(), bearing.sin()];
+                proptest::prop_assert!((placed.extent(direction) - 0.5 * (high - low)).abs() < 1e-9);
+            }
+        }
     }
 }
