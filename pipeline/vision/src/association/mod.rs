@@ -21,8 +21,9 @@
 //!    registration pairs it afterwards under its motion ([`Registration::pair_observers`]),
 //!    and it anchors only as a far rock does. Anchors are checked against each other: a
 //!    triple of anchors whose measured states do not overlap the map's is inconsistent, and
-//!    the anchor in most such triples is dropped until none is left. Matches are then checked against earlier stations' placements of their
-//!    landmarks ([`agreement`], applied by the caller, which keeps the stations' history);
+//!    the anchor in most such triples is dropped until none is left. Matches are then checked
+//!    against earlier stations' placements of their landmarks ([`agreement`], applied by the
+//!    caller, which keeps the stations' history);
 //! 3. every other proposal is tested as 000 §VI-C describes: the detection's triples with
 //!    pairs of anchors are measured and compared with the candidate landmark's relations in
 //!    the map; a candidate with an empty overlap in any relation is rejected;

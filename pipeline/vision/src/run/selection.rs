@@ -176,7 +176,7 @@ fn placed(r: &Ranged) -> Option<Placed> {
 /// their candidates, placed within 2.2 m (median) against 0.38 m for those matched. Over the
 /// likely half, 25 sets fused more (marsyard seed 7: 75.7 → 81.9 %), with 0 unsound relations
 /// once a registration that chance nearly explains no longer anchors a pair on its own against
-/// a significant one (`association::anchors`; docs/RUN.md, stop 63).
+/// a significant one (`association::overruled`; docs/RUN.md, stop 63).
 pub(crate) fn likely_range(
     stereo: Option<RangeInterval>,
     fused: RangeInterval,
