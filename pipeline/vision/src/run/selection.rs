@@ -404,7 +404,8 @@ mod tests {
                 proptest::prop_assert!((centre_range(&placed) - range).abs() <= tolerance * range);
                 proptest::prop_assert!(centre_range(&placed) < 0.5 * (low + high));
                 let direction = [bearing.cos(), bearing.sin()];
-                proptest::prop_assert!((placed.extent(direction) - 0.5 * (high - low)).abs() < 1e-9);
+                let length = placed.extent(direction);
+                proptest::prop_assert!((length - 0.5 * (high - low)).abs() < 1e-9);
             }
         }
     }
