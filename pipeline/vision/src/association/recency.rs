@@ -10,46 +10,30 @@
 //! seen lately: the rover's way back passes landmarks it keeps in view. (Requiring 4 made the
 //! 1 000-rock drive sound but halved the sightings of stress seed 8, which fuses sparsely
 //! enough that true registrations hold a single landmark seen lately.)
-//!
-//! "Lately" counts the stations that fused something, not every station: a rover that fuses
-//! nothing for a while (a stretch where no frame registers) has lost no sight of the
-//! landmarks it fused last, and counting those stations would leave it none to register
-//! against, so that it would never fuse again (stress seed 30, grayscale JPEG: nothing fused
-//! after station 20 for 25 stations at stop 63's placements). They stay seen lately no longer
-//! than the sketch keeps them ([`WINDOW`]).
 
-use super::sketch::WINDOW;
 use qrm_core::map::LandmarkId;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 
-/// Stations that fused something after a landmark's last sighting during which it counts as
-/// seen lately: a few stations of a drive (1–3 m a station on the presets), well inside the
-/// sketch's window.
+/// Stations after its last sighting during which a landmark counts as seen lately: a few
+/// stations of a drive (1–3 m a station on the presets), well inside the sketch's window.
 pub const LATELY_STATIONS: usize = 8;
 
-/// The station at which each landmark was last fused, and the stations that fused any.
+/// The station at which each landmark was last fused.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct LastSeen {
-    last: HashMap<LandmarkId, usize>,
-    fusing: BTreeSet<usize>,
-}
+pub struct LastSeen(HashMap<LandmarkId, usize>);
 
 impl LastSeen {
     /// Records that `landmark` was fused at `station`.
     pub fn record(&mut self, landmark: LandmarkId, station: usize) {
-        let last = self.last.entry(landmark).or_insert(station);
+        let last = self.0.entry(landmark).or_insert(station);
         *last = (*last).max(station);
-        self.fusing.insert(station);
     }
 
-    /// Whether `landmark` was fused before `station` with fewer than [`LATELY_STATIONS`]
-    /// stations that fused anything in between, and no more than [`WINDOW`] stations before.
+    /// Whether `landmark` was fused within the [`LATELY_STATIONS`] stations before `station`.
     pub fn lately(&self, landmark: LandmarkId, station: usize) -> bool {
-        self.last.get(&landmark).is_some_and(|&last| {
-            station <= last + WINDOW
-                && (station <= last
-                    || self.fusing.range(last + 1..station).count() < LATELY_STATIONS)
-        })
+        self.0
+            .get(&landmark)
+            .is_some_and(|&last| station <= last + LATELY_STATIONS)
     }
 }
 
@@ -58,31 +42,15 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_landmark_is_seen_lately_for_a_few_stations_that_fused_after_its_last_sighting() {
+    fn a_landmark_is_seen_lately_for_a_few_stations_after_its_last_sighting() {
         let mut seen = LastSeen::default();
         seen.record(3, 10);
         seen.record(3, 4);
-        for station in 11..=20 {
-            seen.record(5, station);
-        }
-        assert!(seen.lately(3, 10), "at its own station");
         assert!(seen.lately(3, 10 + LATELY_STATIONS));
         assert!(!seen.lately(3, 11 + LATELY_STATIONS));
         assert!(
             !seen.lately(4, 10),
             "a landmark never fused was not seen lately"
         );
-    }
-
-    #[test]
-    fn stations_that_fused_nothing_do_not_age_a_landmark_beyond_the_sketch() {
-        let mut seen = LastSeen::default();
-        seen.record(3, 10);
-        seen.record(5, 12);
-        assert!(
-            seen.lately(3, 10 + WINDOW),
-            "one station fused since, within the window"
-        );
-        assert!(!seen.lately(3, 11 + WINDOW), "the sketch has let it go");
     }
 }
