@@ -957,6 +957,7 @@ mod tests {
             beyond_columns: [0, 0],
             parallax_shifts: None,
             flat: false,
+            surely_flat: false,
         }
     }
 

@@ -174,6 +174,9 @@ pub struct Evidence {
     /// Nothing of it stands up from the ground by stereo ([`crate::detection::Detection::flat`]):
     /// a soil patch or a shadow, or a rock too smooth to tell.
     pub flat: bool,
+    /// Flat where the stereo test tells a standing rock from the ground
+    /// ([`crate::detection::Detection::surely_flat`]): founds no landmark.
+    pub surely_flat: bool,
     /// Rock pixels of the detection: too few ([`MIN_FOUNDING_PIXELS`]) describe no looks.
     pub pixels: u32,
 }
@@ -222,6 +225,9 @@ pub enum Unfounded {
     Doubtful,
     /// Fewer rock pixels than [`MIN_FOUNDING_PIXELS`].
     Small,
+    /// Nothing of it stands up from the ground where the stereo test tells
+    /// ([`Evidence::surely_flat`]).
+    Flat,
     /// Placed looser than any registration pairs ([`LONG_ANCHOR_RADIUS_M`]), or not at all.
     Loose,
 }
@@ -251,6 +257,8 @@ pub fn unfounded(evidence: &Evidence) -> Option<Unfounded> {
         Some(Unfounded::Doubtful)
     } else if evidence.pixels < MIN_FOUNDING_PIXELS {
         Some(Unfounded::Small)
+    } else if evidence.surely_flat {
+        Some(Unfounded::Flat)
     } else if evidence
         .placed
         .is_none_or(|p| p.reach() > LONG_ANCHOR_RADIUS_M)
@@ -989,6 +997,7 @@ mod tests {
                 piece: false,
                 doubtful: false,
                 flat: false,
+                surely_flat: false,
                 pixels: 100,
             })
             .collect();
@@ -1070,6 +1079,17 @@ mod tests {
             0.2,
         ));
         only_the_second_founds_none(station, Unfounded::Loose);
+    }
+
+    /// A detection the stereo test surely finds flat (a soil patch or a shadow) founds no
+    /// landmark; one merely flat (a far or low-contrast rock the test cannot tell) does.
+    #[test]
+    fn a_surely_flat_detection_founds_no_landmark() {
+        let (_, mut station) = station(&[[5.0, 0.0], [0.0, 6.0], [-4.0, -3.0]]);
+        station.detections[1].flat = true;
+        station.detections[1].surely_flat = true;
+        station.detections[2].flat = true;
+        only_the_second_founds_none(station, Unfounded::Flat);
     }
 
     /// A detection of fewer pixels than a 3 × 3 window founds no landmark: its looks are noise.

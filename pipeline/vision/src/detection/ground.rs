@@ -474,6 +474,25 @@ pub(super) fn nearest_face_shift(calib: &Calibration, bottom: f64, cut: bool) ->
     })
 }
 
+/// Whether the test tells a rock whose top is at image row `top` and contact at `contact` from
+/// the ground: standing, its top lies at its contact's range, nearer than the ground seen at
+/// the top's row by [`TOLERANCE_COLUMNS`] of shift or more, so a textured top would fail to
+/// match at the ground's shift. A flat verdict on a lower blob (a far rock's few rows) says
+/// nothing of its height.
+pub(super) fn tells_height(calib: &Calibration, top: f64, contact: f64) -> bool {
+    ground_shift(calib, contact) - ground_shift(calib, top) >= TOLERANCE_COLUMNS
+}
+
+/// Whether half or more of a blob's pixels (their `stances`) are textured and match the other
+/// panorama at the ground's shift: the test saw ground there, rather than a face too smooth
+/// to tell (a low-contrast rock is flat by default).
+pub(super) fn mostly_ground(stances: impl Iterator<Item = Stance>) -> bool {
+    let (ground, all) = stances.fold((0usize, 0usize), |(g, a), s| {
+        (g + usize::from(s == Stance::Ground), a + 1)
+    });
+    all > 0 && 2 * ground >= all
+}
+
 /// The flat ground's stereo shift (columns) at image row `row`; 0 at and above the horizon.
 pub(super) fn ground_shift(calib: &Calibration, row: f64) -> f64 {
     calib.ground_range(row).map_or(0.0, |range| {
@@ -557,6 +576,29 @@ mod tests {
             left,
             right,
         }
+    }
+
+    /// A standing top shows off the ground's shift by `baseline × rows / mast height`
+    /// columns, whatever its range: at 0.3 m and 1.5 m, 7.5 rows for the 1.5-column tolerance.
+    #[test]
+    fn the_test_tells_a_standing_top_from_the_ground_from_eight_rows_up() {
+        let calib = calib();
+        for contact in [100.0, 140.0, 180.0] {
+            assert!(tells_height(&calib, contact - 8.0, contact));
+            assert!(!tells_height(&calib, contact - 7.0, contact));
+        }
+    }
+
+    /// Ground where half or more of the pixels matched at the ground's shift, not where most
+    /// were too smooth to tell.
+    #[test]
+    fn mostly_ground_counts_the_pixels_seen_at_the_grounds_shift() {
+        use Stance::{Ground, Unknown};
+        assert!(mostly_ground(
+            [Ground, Unknown, Ground, Unknown].into_iter()
+        ));
+        assert!(!mostly_ground([Ground, Unknown, Unknown].into_iter()));
+        assert!(!mostly_ground(std::iter::empty()));
     }
 
     #[test]

@@ -216,6 +216,14 @@ pub struct Detection {
     /// and by luminance, where every detection stands by construction.
     #[serde(default)]
     pub flat: bool,
+    /// Flat, with half or more of its pixels matching the other panorama at the ground's shift
+    /// where the test tells a standing rock from the ground ([`ground::tells_height`]: its top
+    /// lies far enough above its contact that, standing, it would not match there): a soil
+    /// patch or a cast shadow. A flat detection lower in the image, or one too smooth to
+    /// match, may be a far or low-contrast rock the test cannot tell. Such a detection founds
+    /// no landmark (`association::unfounded`).
+    #[serde(default)]
+    pub surely_flat: bool,
 }
 
 /// Statistics that change little with viewpoint, for associating a rock across panoramas.
@@ -465,20 +473,27 @@ fn apply_ground_test(
             r < rows && (test.stance(c, r) == ground::Stance::Raised || test.nearer(c, r, shift))
         })
     };
-    let flat: Vec<bool> = detections
+    let flat: Vec<(bool, bool)> = detections
         .par_iter()
         .map(|d| {
             let pixels = &blobs[d.blob as usize];
             let shift = max_shift(pixels, bands.top, rows, bands.calib);
             let columns = d.bbox[0]..=d.bbox[2];
-            !pixels
+            let own: Vec<&(u32, u32)> = pixels.iter().filter(|p| columns.contains(&p.0)).collect();
+            let flat = !own
                 .iter()
-                .filter(|p| columns.contains(&p.0))
-                .any(|&(c, r)| stands(i64::from(c), i64::from(r), shift))
+                .any(|&&(c, r)| stands(i64::from(c), i64::from(r), shift));
+            let stances = own
+                .iter()
+                .filter(|&&&(_, r)| (r as usize) < rows)
+                .map(|&&(c, r)| test.stance(c as usize % w, r as usize));
+            let tells = ground::tells_height(bands.calib, f64::from(d.bbox[1]), d.contact_row);
+            (flat, flat && tells && ground::mostly_ground(stances))
         })
         .collect();
-    for (detection, flat) in detections.iter_mut().zip(flat) {
+    for (detection, (flat, surely)) in detections.iter_mut().zip(flat) {
         detection.flat = flat;
+        detection.surely_flat = surely;
     }
     let reach: std::collections::HashMap<u32, [u32; 2]> = detected_blobs(detections)
         .into_par_iter()
@@ -837,6 +852,7 @@ fn accept(
         beyond_columns: [0, 0],
         parallax_shifts: None,
         flat: false,
+        surely_flat: false,
     })
 }
 
@@ -980,7 +996,7 @@ mod tests {
     /// A grey patch on textured soil, seen by a quarter-size stereo pair: painted on the
     /// ground (the right panorama sees each of its rows at the ground's shift) nothing of it
     /// stands and its detection is flat; as a rock's face (every row at its contact's shift)
-    /// it stands. Without stereo nothing is flat (untested).
+    /// it stands, and is not surely flat. Without stereo nothing is flat (untested).
     #[test]
     fn a_patch_on_the_ground_is_flat_and_a_standing_face_is_not() {
         let calib = Calibration::parse(
@@ -991,7 +1007,7 @@ mod tests {
         )
         .expect("valid");
         let (w, h) = (1024u32, 192u32);
-        let (rows, columns) = (95..120u32, 500.0..530.0);
+        let columns = 500.0..530.0;
         // A level per whole pixel, from a hash of its column and row.
         let level = |x: f64, y: u32| {
             let mut k =
@@ -1001,10 +1017,10 @@ mod tests {
             k ^= k >> 32;
             0.9 + 0.2 * (k % 1000) as f32 / 1000.0
         };
-        let contact = ground::ground_shift(&calib, f64::from(rows.end));
         // The panorama whose columns see the world's columns shifted by `eye` (0 left, 1 right,
-        // the right camera seeing a point at a smaller column).
-        let pair = |standing: bool| {
+        // the right camera seeing a point at a smaller column), the patch over `rows`.
+        let pair = |standing: bool, rows: std::ops::Range<u32>| {
+            let contact = ground::ground_shift(&calib, f64::from(rows.end));
             let paint = |eye: f64| {
                 image::RgbImage::from_fn(w, h, |x, y| {
                     let ground =
@@ -1036,11 +1052,12 @@ mod tests {
                 .find(|d| d.bbox[0] < 530 && d.bbox[2] >= 500 && d.bbox[1] < 120 && d.bbox[3] >= 95)
                 .unwrap_or_else(|| panic!("the patch is detected"))
         };
-        let (left, right) = pair(false);
+        let (left, right) = pair(false, 95..120);
         assert!(patch(&left, Some(&right), &colour).flat);
         assert!(!patch(&left, None, &colour).flat);
-        let (left, right) = pair(true);
-        assert!(!patch(&left, Some(&right), &colour).flat);
+        let (left, right) = pair(true, 95..120);
+        let standing = patch(&left, Some(&right), &colour);
+        assert!(!standing.flat && !standing.surely_flat);
     }
 
     /// A one-pixel crack inside a blob is bridged; the blob does not grow, even at the edge.

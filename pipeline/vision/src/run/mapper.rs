@@ -1049,6 +1049,7 @@ mod tests {
                 piece: false,
                 doubtful: false,
                 flat: false,
+                surely_flat: false,
                 pixels: 100,
             },
             recognised: Vec::new(),

@@ -122,6 +122,10 @@ pub enum Exclusion {
     /// Matched no landmark and placed too loosely to found one (a far rock whose range
     /// interval spans metres: `association::unfounded`).
     Loose,
+    /// Nothing of it stands up from the ground by stereo (`Detection::flat`: a soil patch or
+    /// a shadow, or a rock too smooth or far to tell), and it matched no landmark: a flat
+    /// detection founds none (`association::unfounded`).
+    Flat,
     /// Narrower than a 512th of the view: mostly pieces of larger rocks.
     Sliver,
     /// Matched no landmark and too small to found one (`association::MIN_FOUNDING_PIXELS`).
@@ -144,6 +148,7 @@ impl From<Unfounded> for Exclusion {
             Unfounded::Doubtful => Exclusion::Doubted,
             Unfounded::Small => Exclusion::Small,
             Unfounded::Loose => Exclusion::Loose,
+            Unfounded::Flat => Exclusion::Flat,
         }
     }
 }

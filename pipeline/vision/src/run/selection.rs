@@ -135,6 +135,7 @@ pub(crate) fn station_evidence(
                 piece: ranged[i].piece,
                 doubtful: observes(station, ranged, i),
                 flat: station.primary[i].flat,
+                surely_flat: station.primary[i].surely_flat,
                 pixels: station.primary[i].pixels,
             })
             .collect(),
@@ -217,6 +218,7 @@ mod tests {
             beyond_columns: [0, 0],
             parallax_shifts: None,
             flat: false,
+            surely_flat: false,
         }
     }
 
