@@ -475,12 +475,14 @@ pub(super) fn nearest_face_shift(calib: &Calibration, bottom: f64, cut: bool) ->
 }
 
 /// Whether the test tells a rock whose top is at image row `top` and contact at `contact` from
-/// the ground: standing, its top lies at its contact's range, nearer than the ground seen at
-/// the top's row by [`TOLERANCE_COLUMNS`] of shift or more, so a textured top would fail to
-/// match at the ground's shift. A flat verdict on a lower blob (a far rock's few rows) says
-/// nothing of its height.
+/// the ground: standing, its rows at least [`RADIUS`] below the top (the highest whose matching
+/// window lies on the rock alone) lie at its contact's range, nearer than the ground seen there
+/// by [`TOLERANCE_COLUMNS`] of shift or more, so a textured top would fail to match at the
+/// ground's shift. A flat verdict on a lower blob (a far rock's few rows: sparse-large's rocks
+/// 25–32 m away, 8 rows tall just under the horizon) says nothing of its height.
 pub(super) fn tells_height(calib: &Calibration, top: f64, contact: f64) -> bool {
-    ground_shift(calib, contact) - ground_shift(calib, top) >= TOLERANCE_COLUMNS
+    let judged = top + RADIUS as f64;
+    ground_shift(calib, contact) - ground_shift(calib, judged) >= TOLERANCE_COLUMNS
 }
 
 /// Whether half or more of a blob's pixels (their `stances`) are textured and match the other
@@ -578,14 +580,19 @@ mod tests {
         }
     }
 
-    /// A standing top shows off the ground's shift by `baseline × rows / mast height`
-    /// columns, whatever its range: at 0.3 m and 1.5 m, 7.5 rows for the 1.5-column tolerance.
+    /// A standing rock's row shows off the ground's shift by `baseline × rows / mast height`
+    /// columns, whatever its range: at 0.3 m and 1.5 m, 7.5 rows for the 1.5-column tolerance,
+    /// counted from the highest row the matching window judges on the rock alone.
     #[test]
-    fn the_test_tells_a_standing_top_from_the_ground_from_eight_rows_up() {
+    fn the_test_tells_a_standing_top_from_the_ground_from_ten_rows_up() {
         let calib = calib();
         for contact in [100.0, 140.0, 180.0] {
-            assert!(tells_height(&calib, contact - 8.0, contact));
-            assert!(!tells_height(&calib, contact - 7.0, contact));
+            assert!(tells_height(&calib, contact - 8.0 - RADIUS as f64, contact));
+            assert!(!tells_height(
+                &calib,
+                contact - 7.0 - RADIUS as f64,
+                contact
+            ));
         }
     }
 
