@@ -1007,7 +1007,7 @@ mod tests {
         )
         .expect("valid");
         let (w, h) = (1024u32, 192u32);
-        let columns = 500.0..530.0;
+        let (rows, columns) = (95..120u32, 500.0..530.0);
         // A level per whole pixel, from a hash of its column and row.
         let level = |x: f64, y: u32| {
             let mut k =
@@ -1017,10 +1017,10 @@ mod tests {
             k ^= k >> 32;
             0.9 + 0.2 * (k % 1000) as f32 / 1000.0
         };
+        let contact = ground::ground_shift(&calib, f64::from(rows.end));
         // The panorama whose columns see the world's columns shifted by `eye` (0 left, 1 right,
-        // the right camera seeing a point at a smaller column), the patch over `rows`.
-        let pair = |standing: bool, rows: std::ops::Range<u32>| {
-            let contact = ground::ground_shift(&calib, f64::from(rows.end));
+        // the right camera seeing a point at a smaller column).
+        let pair = |standing: bool| {
             let paint = |eye: f64| {
                 image::RgbImage::from_fn(w, h, |x, y| {
                     let ground =
@@ -1052,10 +1052,10 @@ mod tests {
                 .find(|d| d.bbox[0] < 530 && d.bbox[2] >= 500 && d.bbox[1] < 120 && d.bbox[3] >= 95)
                 .unwrap_or_else(|| panic!("the patch is detected"))
         };
-        let (left, right) = pair(false, 95..120);
+        let (left, right) = pair(false);
         assert!(patch(&left, Some(&right), &colour).flat);
         assert!(!patch(&left, None, &colour).flat);
-        let (left, right) = pair(true, 95..120);
+        let (left, right) = pair(true);
         let standing = patch(&left, Some(&right), &colour);
         assert!(!standing.flat && !standing.surely_flat);
     }
