@@ -242,8 +242,8 @@ pub fn print_report(e: &Evaluation) {
     );
     for (name, m) in [("run", &e.map.run), ("exact", &e.map.exact)] {
         println!(
-            "  map ({name:<5}): {} landmarks, {} triples, {:.1} % open ({:.1} % among landmarks of one rock each), {:.1} % of incorrect states removed, {:.1} % fully constrained, {} unsound relations",
-            m.landmarks, m.triples, m.open_pct, m.open_pct_defined, m.removed_incorrect_pct, m.fully_constrained_pct, m.unsound_relations
+            "  map ({name:<5}): {} landmarks, {} triples, {:.1} % open ({:.1} % among landmarks of one rock each), {:.1} % of incorrect states removed ({:.1} % among landmarks of one rock each), {:.1} % fully constrained, {} unsound relations",
+            m.landmarks, m.triples, m.open_pct, m.open_pct_defined, m.removed_incorrect_pct, m.removed_incorrect_pct_defined, m.fully_constrained_pct, m.unsound_relations
         );
         if !m.unsound_landmarks.is_empty() {
             let worst: Vec<String> = m

@@ -137,14 +137,22 @@ fn map_score<C: Calculus>(
     defined: &dyn Fn(LandmarkId) -> bool,
 ) -> MapMetricsScore {
     let m = evaluate(map, truth, map.len());
+    let universe = C::universe().len();
     let mut unsound: HashMap<LandmarkId, usize> = HashMap::new();
-    let (mut open, mut states) = (0usize, 0usize);
+    let (mut open, mut states, mut removed) = (0usize, 0usize, 0usize);
     for (a, b, c, relations) in map.triples() {
+        let ordered = [(a, b, c), (b, c, a), (c, a, b)];
         if defined(a) && defined(b) && defined(c) {
             open += relations.iter().map(|s| s.len()).sum::<usize>();
-            states += 3 * C::universe().len();
+            states += 3 * universe;
+            removed += relations
+                .iter()
+                .zip(ordered)
+                .filter(|(set, (x, y, z))| truth(*x, *y, *z).is_some_and(|t| set.contains(t)))
+                .map(|(set, _)| universe - set.len())
+                .sum::<usize>();
         }
-        for (set, (x, y, z)) in relations.iter().zip([(a, b, c), (b, c, a), (c, a, b)]) {
+        for (set, (x, y, z)) in relations.iter().zip(ordered) {
             if truth(x, y, z).is_some_and(|t| !set.contains(t)) {
                 for l in [x, y, z] {
                     *unsound.entry(l).or_default() += 1;
@@ -152,6 +160,10 @@ fn map_score<C: Calculus>(
             }
         }
     }
+    // Over every triple of one-rock landmarks, measured or not, as `evaluate` counts the
+    // paper's figure over every triple of the map's landmarks (000 Fig. 7a).
+    let n = map.landmarks().iter().filter(|&&l| defined(l)).count();
+    let incorrect = n * n.saturating_sub(1) * n.saturating_sub(2) / 6 * 3 * (universe - 1);
     let mut unsound_landmarks: Vec<(LandmarkId, usize)> = unsound.into_iter().collect();
     unsound_landmarks.sort_by_key(|&(l, n)| (std::cmp::Reverse(n), l));
     MapMetricsScore {
@@ -161,8 +173,64 @@ fn map_score<C: Calculus>(
         open_pct: m.open_pct,
         open_pct_defined: 100.0 * ratio(open, states),
         removed_incorrect_pct: m.removed_incorrect_pct,
+        removed_incorrect_pct_defined: 100.0 * ratio(removed, incorrect),
         fully_constrained_pct: m.fully_constrained_pct,
         unsound_relations: m.unsound_relations,
         undefined_triples: m.undefined_triples,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Landmarks 0–3 seen exactly from two stations; landmark 3 is a false detection's, with
+    /// no true state in any triple.
+    fn two_station_map() -> (Hypergraph<Edc>, [Point; 4]) {
+        let rocks = [
+            Point::new(4.0, 1.0),
+            Point::new(6.0, -3.0),
+            Point::new(9.0, 2.0),
+            Point::new(3.0, 5.0),
+        ];
+        let mut map = Hypergraph::<Edc>::new();
+        for station in [Point::new(0.0, 0.0), Point::new(1.0, -6.0)] {
+            let polar: Vec<(f64, f64)> = rocks
+                .iter()
+                .map(|p| {
+                    let (dx, dy) = (p.x - station.x, p.y - station.y);
+                    (dy.atan2(dx).rem_euclid(TAU), dx.hypot(dy))
+                })
+                .collect();
+            let mut nearest_first: Vec<usize> = (0..rocks.len()).collect();
+            nearest_first.sort_by(|&a, &b| polar[a].1.total_cmp(&polar[b].1));
+            let order = RangeOrder::total(&nearest_first).expect("a permutation");
+            let view = StationView::new(polar.iter().map(|p| Bearing::exact(p.0)).collect(), order)
+                .expect("a valid view");
+            let batch = map.observations(&view, &Sighting::all(&[0, 1, 2, 3]));
+            map.fuse(&batch).expect("exact measurements agree");
+        }
+        (map, rocks)
+    }
+
+    #[test]
+    fn removed_states_among_one_rock_landmarks_leave_a_false_detections_triples_out() {
+        let (map, rocks) = two_station_map();
+        let defined = |l: LandmarkId| l < 3;
+        let truth = |a: LandmarkId, b: LandmarkId, c: LandmarkId| {
+            [a, b, c]
+                .iter()
+                .all(|&l| defined(l))
+                .then(|| Edc::classify(rocks[a as usize], rocks[b as usize], rocks[c as usize]))
+                .flatten()
+        };
+        let score = map_score(&map, &truth, &defined);
+        let alone = evaluate(&map.restricted(defined), truth, 3);
+        assert!(alone.removed_incorrect_pct > 0.0);
+        assert!((score.removed_incorrect_pct_defined - alone.removed_incorrect_pct).abs() < 1e-9);
+        // Over all four landmarks, the three triples with landmark 3 count as unresolved.
+        let over_all = score.removed_incorrect_pct_defined / 4.0;
+        assert!((score.removed_incorrect_pct - over_all).abs() < 1e-9);
+        assert_eq!(score.unsound_relations, 0);
     }
 }
