@@ -22,7 +22,7 @@
 use crate::association::{associate, AssociationSettings, Decision, Frame, Gallery};
 use crate::calib::Calibration;
 use crate::ranging::{self, RangeInterval, SensorModel};
-use crate::run::selection::{placement, station_evidence, usable_firm};
+use crate::run::selection::{likely_range, placement, station_evidence, usable_firm};
 use crate::run::{LandmarkRecord, StationDetections, StationRecord};
 use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, LandmarkId, Sighting};
@@ -101,7 +101,13 @@ impl<C: Calculus> KnownMap<C> {
                     .enumerate()
                     .filter_map(|(i, d)| {
                         let landmark = *landmark_of.get(&(record.index, i))?;
-                        let placed = placement(d.bearing, d.bearing_uncertainty, d.range.fused)?;
+                        let interval = |[low, high]: [f64; 2]| RangeInterval::new(low, high);
+                        let range = likely_range(
+                            d.range.stereo.map(interval),
+                            interval(d.range.fused),
+                            d.range.conflict,
+                        );
+                        let placed = placement(d.bearing, d.bearing_uncertainty, range.as_array())?;
                         Some((landmark, placed))
                     })
                     .collect(),
