@@ -330,9 +330,11 @@ pub fn associate<C: Calculus>(
         &seen,
         lately,
     );
+    // The station's usable detections' rays lead `seen`.
+    let rays = &seen[..n];
     let elsewhere = unplaced_rays(station, &firm);
     for (frame, registration) in &mut registrations {
-        registration.drop_pairs_seen_elsewhere(frame, &firm, &elsewhere);
+        registration.drop_pairs_seen_elsewhere(frame, &firm, rays, &elsewhere);
     }
     // The dropped pairs' landmarks may be other rocks, so they no longer support the motion:
     // fewer than the fewest believed left, and the fit is not trusted (the 1 000-rock drive,
@@ -346,7 +348,7 @@ pub fn associate<C: Calculus>(
     let alike = |i: usize, l: LandmarkId| looks_alike(&candidates, i, l);
     for (frame, registration) in &mut registrations {
         registration.pair_observers(frame, &placed, &observers, &alike);
-        registration.drop_pairs_seen_elsewhere(frame, &placed, &unplaced);
+        registration.drop_pairs_seen_elsewhere(frame, &placed, rays, &unplaced);
     }
     let min_support = if station.colour {
         1
@@ -1041,6 +1043,7 @@ mod tests {
             azimuth: p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU),
             half_baseline: 0.0,
             nearest: 0.0,
+            half_width: 0.0,
         }
     }
 

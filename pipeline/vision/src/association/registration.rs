@@ -571,19 +571,25 @@ impl Registration {
     /// Drops the pairs whose landmark, brought back into the current station by the motion,
     /// lies in a direction nearer to where one of the station's detections without a placement
     /// was seen (its ray in `elsewhere`, at the landmark's range) than to its paired
-    /// detection's: the landmark may be that rock
+    /// detection's (placed `placed[i]`, seen along `rays[i]`): the landmark may be that rock
     /// (on half-resolution marsyard seed 4, a rock 1.8 m from a landmark's, seen while the
     /// landmark's own rock was detected but touching another, took the landmark at three
-    /// stations: 2 unsound relations). Not a ray that starts beyond the landmark's reach
-    /// ([`Ray::nearest`]): that rock is farther. Unranged detections up the image, whose
-    /// contacts nearer rocks hide, lie in nearly every near rock's direction (grayscale
-    /// marsyard seed 7, station 4: a rock ≥ 5 m away, 0.01° from landmark 20 at 2 m, dropped
-    /// its own rock's pair, and two neighbours were held back with it as their only candidate);
-    /// of the pairs this test dropped on colour marsyard seed 7, 57 were right and 3 wrong.
+    /// stations: 2 unsound relations). Nearer either way a blob is judged: by its centre, or by
+    /// the nearest column of its span ([`Ray::half_width`]), since a rock's centre may lie
+    /// anywhere across its blob (the 1 000-rock drive, station 235: a landmark brought back
+    /// 0.062 rad from its paired detection's centre and 0.081 from an unranged one's, but
+    /// 5 columns from the unranged blob's edge and 9 from its pair's, was the unranged blob's
+    /// rock). Not a ray that starts beyond the landmark's reach ([`Ray::nearest`]): that rock
+    /// is farther. Unranged detections up the image, whose contacts nearer rocks hide, lie in
+    /// nearly every near rock's direction (grayscale marsyard seed 7, station 4: a rock ≥ 5 m
+    /// away, 0.01° from landmark 20 at 2 m, dropped its own rock's pair, and two neighbours were
+    /// held back with it as their only candidate); of the pairs this test dropped on colour
+    /// marsyard seed 7, 57 were right and 3 wrong.
     pub fn drop_pairs_seen_elsewhere(
         &mut self,
         frame: &Frame,
         placed: &[Option<Placed>],
+        rays: &[Ray],
         elsewhere: &[Ray],
     ) {
         let direction = |p: [f64; 2]| p[1].atan2(p[0]);
@@ -595,11 +601,17 @@ impl Registration {
             };
             let back = motion.unapply(q.point);
             let (range, back) = (back[0].hypot(back[1]), direction(back));
-            let own = angular_distance(back, direction(p.point));
+            let across = |ray: &Ray| {
+                (angular_distance(back, ray.direction_at(range)) - ray.half_width).max(0.0)
+            };
+            let (own, own_across) = (angular_distance(back, direction(p.point)), across(&rays[i]));
             elsewhere
                 .iter()
                 .filter(|ray| ray.nearest <= range + q.reach() + SLACK_M)
-                .all(|ray| angular_distance(back, ray.direction_at(range)) >= own)
+                .all(|ray| {
+                    angular_distance(back, ray.direction_at(range)) >= own
+                        && across(ray) >= own_across
+                })
         });
     }
 
@@ -1606,6 +1618,7 @@ pub(super) mod tests {
             azimuth,
             half_baseline: 0.0,
             nearest: 0.0,
+            half_width: 0.0,
         };
         let detected: Vec<Ray> = FIELD[..4].iter().map(|&p| ray(bearing(p))).collect();
         // Rock 3 was detected (unpaired, but seen); rocks 4 (11.3 m) and 5 (6.7 m) were not.
@@ -1706,9 +1719,16 @@ pub(super) mod tests {
             azimuth,
             half_baseline: 0.0,
             nearest: 0.0,
+            half_width: 0.0,
         };
+        let own = [ray(1.6f64.atan2(3.0)), ray((-2f64).atan2(5.0))];
         let pairs = registration.pairs.clone();
-        registration.drop_pairs_seen_elsewhere(&frame, &placed, &[ray(1f64.atan2(3.0)), ray(2.0)]);
+        registration.drop_pairs_seen_elsewhere(
+            &frame,
+            &placed,
+            &own,
+            &[ray(1f64.atan2(3.0)), ray(2.0)],
+        );
         assert_eq!(registration.pairs, vec![(1, 11)]);
         // The left eye alone, half a 0.3 m baseline beside the centre, saw the same rock
         // asin(0.15 / 3.16) = 2.7° short of the centre's bearing: along its ray the landmark is
@@ -1717,12 +1737,13 @@ pub(super) mod tests {
             azimuth: 1f64.atan2(3.0) - (0.15 / 10f64.sqrt()).asin(),
             half_baseline: 0.15,
             nearest: 0.0,
+            half_width: 0.0,
         };
         let middle = left_eye.azimuth + std::f64::consts::FRAC_PI_4;
         registration.pairs = pairs.clone();
-        registration.drop_pairs_seen_elsewhere(&frame, &placed, &[ray(middle), ray(2.0)]);
+        registration.drop_pairs_seen_elsewhere(&frame, &placed, &own, &[ray(middle), ray(2.0)]);
         assert_eq!(registration.pairs, pairs, "seen 45° away, it says nothing");
-        registration.drop_pairs_seen_elsewhere(&frame, &placed, &[left_eye, ray(2.0)]);
+        registration.drop_pairs_seen_elsewhere(&frame, &placed, &own, &[left_eye, ray(2.0)]);
         assert_eq!(registration.pairs, vec![(1, 11)]);
         // Seen straight at landmark 10 (3.16 m away, placed within 0.2 m) by a detection that
         // lies at least `nearest` metres away: beyond the landmark and the slack, it is
@@ -1733,8 +1754,35 @@ pub(super) mod tests {
                 ..ray(1f64.atan2(3.0))
             };
             registration.pairs = pairs.clone();
-            registration.drop_pairs_seen_elsewhere(&frame, &placed, &[behind, ray(2.0)]);
+            registration.drop_pairs_seen_elsewhere(&frame, &placed, &own, &[behind, ray(2.0)]);
             assert_eq!(registration.pairs == pairs, kept, "nearest {nearest}");
+        }
+        // A blob whose centre lies farther round than detection 0's (0.2 rad from landmark 10
+        // against 0.17) but whose span reaches within 0.1 rad of it, while detection 0's blob
+        // ends 0.17 rad away: the landmark may be that blob's rock. Once detection 0's own blob
+        // spans to within 0.07 rad, or over the landmark, its pair stands.
+        let wide = Ray {
+            half_width: 0.1,
+            ..ray(1f64.atan2(3.0) - 0.2)
+        };
+        let spanning = |half_width: f64| {
+            [
+                Ray {
+                    half_width,
+                    ..own[0]
+                },
+                own[1],
+            ]
+        };
+        for (own, kept) in [(own, false), (spanning(0.1), true), (spanning(0.2), true)] {
+            registration.pairs = pairs.clone();
+            registration.drop_pairs_seen_elsewhere(&frame, &placed, &own, &[wide, ray(2.0)]);
+            assert_eq!(
+                registration.pairs == pairs,
+                kept,
+                "own half width {}",
+                own[0].half_width
+            );
         }
     }
 

@@ -87,6 +87,9 @@ pub struct Ray {
     /// Least range (metres from the centre) its rock can lie at ([`nearest`]): the ray starts
     /// there. 0 when the panorama bounds nothing.
     pub nearest: f64,
+    /// Half the azimuth (radians) its blob spans, a piece's over the columns it may reach
+    /// ([`Ranged::piece`]): its rock's centre may lie anywhere across it, not only on the ray.
+    pub half_width: f64,
 }
 
 impl Ray {
@@ -96,6 +99,7 @@ impl Ray {
             azimuth: azimuth.rem_euclid(TAU),
             half_baseline: 0.0,
             nearest: 0.0,
+            half_width: 0.0,
         }
     }
 
@@ -193,6 +197,7 @@ pub fn observe(
                 bearing,
                 ray: Ray {
                     nearest: nearest(i, primary, fused, calib, model),
+                    half_width: 0.5 * reach_width,
                     ..ray
                 },
                 piece,
@@ -555,6 +560,7 @@ fn bearing_of(
                 azimuth: (left + shift).rem_euclid(TAU),
                 half_baseline,
                 nearest: 0.0,
+                half_width: 0.0,
             };
             let (small, large) = (eye.offset_at(range.high), eye.offset_at(range.low));
             (left + 0.5 * (small + large), 0.5 * (large - small), eye)
@@ -941,6 +947,7 @@ mod tests {
                         azimuth: 0.0,
                         half_baseline: 0.0,
                         nearest: 0.0,
+                        half_width: 0.0,
                     },
                     stereo_column: None,
                     angular_width: 0.01,

@@ -1045,6 +1045,7 @@ mod tests {
                     azimuth: p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU),
                     half_baseline: 0.0,
                     nearest: 0.0,
+                    half_width: 0.0,
                 },
                 piece: false,
                 doubtful: false,

@@ -272,6 +272,7 @@ mod tests {
                 azimuth: 1.0,
                 half_baseline: 0.0,
                 nearest: 0.0,
+                half_width: 0.0,
             },
             stereo_column: None,
             angular_width: 0.01,
