@@ -87,8 +87,9 @@ pub struct Ray {
     /// Least range (metres from the centre) its rock can lie at ([`nearest`]): the ray starts
     /// there. 0 when the panorama bounds nothing.
     pub nearest: f64,
-    /// Half the azimuth (radians) its blob spans, a piece's over the columns it may reach
-    /// ([`Ranged::piece`]): its rock's centre may lie anywhere across it, not only on the ray.
+    /// Half the azimuth (radians) its blob spans ([`Ranged::angular_width`]; a piece's own
+    /// columns, not those it may reach over: a touching neighbour's rock is the neighbour's):
+    /// its rock's centre may lie anywhere across it, not only on the ray.
     pub half_width: f64,
 }
 
@@ -197,7 +198,7 @@ pub fn observe(
                 bearing,
                 ray: Ray {
                     nearest: nearest(i, primary, fused, calib, model),
-                    half_width: 0.5 * reach_width,
+                    half_width: 0.5 * angular_width,
                     ..ray
                 },
                 piece,
