@@ -122,9 +122,11 @@ pub enum Exclusion {
     /// Matched no landmark and placed too loosely to found one (a far rock whose range
     /// interval spans metres: `association::unfounded`).
     Loose,
-    /// Nothing of it stands up from the ground by stereo (`Detection::flat`: a soil patch or
-    /// a shadow, or a rock too smooth or far to tell), and it matched no landmark: a flat
-    /// detection founds none (`association::unfounded`).
+    /// Surely flat by stereo (`Detection::surely_flat`: nothing of it stands up where the test
+    /// tells a standing rock from the ground, and half or more of it matched at the ground's
+    /// shift: a soil patch or a shadow), and it matched no landmark: such a detection founds
+    /// none (`association::unfounded`). A merely flat one, maybe a rock too smooth or far to
+    /// tell, still founds.
     Flat,
     /// Narrower than a 512th of the view: mostly pieces of larger rocks.
     Sliver,
