@@ -141,7 +141,7 @@ impl Sketch {
         self.departed
             .retain(|d| !self.landmarks.iter().any(|s| s.landmark == d.landmark));
         self.departed.extend(departed);
-        self.updated = Some(station);
+        self.updated = self.updated.max(Some(station));
         true
     }
 
@@ -184,7 +184,8 @@ impl Sketch {
                 }
                 .at_least(MIN_RADIUS_M);
                 s.weight = total;
-                s.seen = station;
+                // A revisited station is older than the latest to see the landmark.
+                s.seen = s.seen.max(station);
             }
             None => self.landmarks.push(Sketched {
                 landmark,

@@ -95,6 +95,33 @@ struct HeldBack {
     recognised: Vec<LandmarkId>,
 }
 
+/// A station whose detections registered against no frame and were all held back, then
+/// given up: no landmark the map held was near enough in the drive, or seen alike enough,
+/// for any pair to anchor. On surveys of random imaging points the first few stations see
+/// the field from 10–20 m apart and none registers until one is taken near an earlier one;
+/// every station before it was lost (stress seed 9: stations 1–7, 135 detections). Later
+/// stations may give it frames to register against ([`Mapper::revisit_stalled`]).
+#[derive(Clone, Debug)]
+struct Stalled {
+    index: usize,
+    station: StationDetections,
+    /// Its detections' range evidence before the size cue, and the usable ones.
+    ranged: Vec<Ranged>,
+    usable: Vec<usize>,
+    /// How many of its detections were held back, and given up.
+    held: usize,
+    /// The map's revision when it was last tried.
+    revision: u64,
+}
+
+/// A station's association, decided and not yet fused.
+struct Decided {
+    associated: Associated,
+    /// The held-back observations of earlier stations its matches recognise, with the
+    /// station of each.
+    recognitions: Vec<(usize, Recognition)>,
+}
+
 /// The map being built and what association needs to remember.
 pub struct Mapper<C: Calculus> {
     pub map: Hypergraph<C>,
@@ -114,6 +141,8 @@ pub struct Mapper<C: Calculus> {
     pub sighted: Vec<Sighted>,
     /// Held-back observations given up after [`HOLD_STATIONS`].
     pub expired: usize,
+    /// Stalled stations within the sketch's window, oldest first.
+    stalled: Vec<Stalled>,
     next_landmark: LandmarkId,
     /// `(station, detection) → landmark` for every fused detection, for evaluation.
     pub sightings: Vec<(usize, usize, LandmarkId)>,
@@ -140,6 +169,7 @@ impl<C: Calculus> Mapper<C> {
             last_seen: LastSeen::default(),
             sighted: Vec::new(),
             expired: 0,
+            stalled: Vec::new(),
             next_landmark: 0,
             sightings: Vec::new(),
             rng: RngEstimate::default(),
@@ -183,7 +213,7 @@ impl<C: Calculus> Mapper<C> {
             ..StationRecord::default()
         };
         let start = Instant::now();
-        let mut ranged = ranging::observe(
+        let ranged = ranging::observe(
             &station.primary,
             station.right.as_deref(),
             station.eye,
@@ -192,18 +222,7 @@ impl<C: Calculus> Mapper<C> {
         );
         record.seconds.range = start.elapsed().as_secs_f64();
         let usable = selection::usable(station, &ranged, self.calib.image.width);
-        record.detections = station
-            .primary
-            .iter()
-            .zip(&ranged)
-            .enumerate()
-            .map(|(i, (d, r))| DetectionRecord {
-                association: Association::Unused {
-                    reason: selection::exclusion(station, &ranged, i, self.calib.image.width),
-                },
-                ..detection_record(d, r)
-            })
-            .collect();
+        record.detections = self.detection_records(station, &ranged);
         record.fusion.usable = usable.len();
         if usable.len() < 3 {
             record.warnings.push(format!(
@@ -220,22 +239,76 @@ impl<C: Calculus> Mapper<C> {
             return record;
         }
 
+        let (fused, held) = self.map_station(&mut record, station, ranged.clone(), usable.clone());
         let start = Instant::now();
-        let evidence = selection::station_evidence(station, &ranged, &usable, &self.sensor);
-        let mut recent: Vec<&Sighted> = self
-            .recent(index)
+        self.revisit_stalled(&mut record);
+        record.fusion.resolved_held_back = self.retry_held_back(&mut record);
+        // Its held-back detections, with no fused partner to be measured with, were given up.
+        if fused == 0 && held > 0 {
+            self.stalled.push(Stalled {
+                index,
+                station: station.clone(),
+                ranged,
+                usable,
+                held,
+                revision: self.revision,
+            });
+        }
+        record.seconds.map += start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        record.metrics = self.refresh_metrics();
+        record.seconds.metrics = start.elapsed().as_secs_f64();
+        record
+    }
+
+    /// The station's detections as records, each unused with the reason mapping leaves it
+    /// out until association decides.
+    fn detection_records(
+        &self,
+        station: &StationDetections,
+        ranged: &[Ranged],
+    ) -> Vec<DetectionRecord> {
+        station
+            .primary
             .iter()
-            .rev()
-            .filter(|s| s.frame.registrable())
-            .take(RECENT_FRAMES)
-            .collect();
-        recent.reverse();
-        // Each frame with the station it is the frame of (none for the sketch).
-        let (stations, frames): (Vec<Option<usize>>, Vec<Frame>) =
-            std::iter::once((None, self.sketch.frame(index)))
-                .filter(|(_, frame)| frame.registrable())
-                .chain(recent.iter().map(|s| (Some(s.station), s.frame.clone())))
-                .unzip();
+            .zip(ranged)
+            .enumerate()
+            .map(|(i, (d, r))| DetectionRecord {
+                association: Association::Unused {
+                    reason: selection::exclusion(station, ranged, i, self.calib.image.width),
+                },
+                ..detection_record(d, r)
+            })
+            .collect()
+    }
+
+    /// Associates and fuses the usable detections of station `record.index`: the record gets
+    /// their decisions, fusion outcome and the stage times of association and mapping.
+    /// Returns how many detections were fused and held back.
+    fn map_station(
+        &mut self,
+        record: &mut StationRecord,
+        station: &StationDetections,
+        ranged: Vec<Ranged>,
+        usable: Vec<usize>,
+    ) -> (usize, usize) {
+        let start = Instant::now();
+        let decided = self.decide(record.index, station, &ranged, usable);
+        record.seconds.associate += start.elapsed().as_secs_f64();
+        self.fuse_decided(record, station, ranged, decided)
+    }
+
+    /// The association of station `index`'s usable detections (000 §VI-C), with the
+    /// recognitions its matches make.
+    fn decide(
+        &self,
+        index: usize,
+        station: &StationDetections,
+        ranged: &[Ranged],
+        usable: Vec<usize>,
+    ) -> Decided {
+        let evidence = selection::station_evidence(station, ranged, &usable, &self.sensor);
+        let (stations, frames) = self.frames(index);
         let association = associate(
             &self.map,
             &self.gallery,
@@ -252,33 +325,157 @@ impl<C: Calculus> Mapper<C> {
             .filter(|r| decisions[r.detection] == Decision::Matched(r.landmark))
             .filter_map(|r| Some((stations[r.frame]?, r)))
             .collect();
-        record.seconds.associate = start.elapsed().as_secs_f64();
+        Decided {
+            associated: Associated::new(usable, evidence, decisions, self.next_landmark),
+            recognitions,
+        }
+    }
 
+    /// Fuses a station's decided detections; returns how many were fused and held back (none
+    /// when the map rejected the panorama).
+    fn fuse_decided(
+        &mut self,
+        record: &mut StationRecord,
+        station: &StationDetections,
+        mut ranged: Vec<Ranged>,
+        decided: Decided,
+    ) -> (usize, usize) {
         let start = Instant::now();
-        for (position, decision) in decisions.iter().enumerate() {
+        let Decided {
+            associated,
+            recognitions,
+        } = decided;
+        for (position, decision) in associated.decisions.iter().enumerate() {
             if let Decision::Withheld(why) = decision {
-                record.detections[usable[position]].association = Association::Unused {
+                record.detections[associated.usable[position]].association = Association::Unused {
                     reason: Some(Exclusion::from(*why)),
                 };
             }
         }
-        let associated = Associated::new(usable, evidence, decisions, self.next_landmark);
+        let counts = (associated.fused.len(), associated.held.len());
         self.apply_size_cue(station, &mut ranged, &associated);
         for (i, r) in ranged.iter().enumerate() {
             record.detections[i].range = detection_record(&station.primary[i], r).range;
         }
         let view = selection::view_of(&ranged, &associated.usable);
         record.order = asserted_order(&view, &associated.usable);
-        if self.fuse_station(&mut record, associated, view) {
-            self.fuse_recognised(&mut record, &recognitions);
+        let fused = self.fuse_station(record, associated, view);
+        if fused {
+            self.fuse_recognised(record, &recognitions);
         }
-        self.audit(&mut record);
-        record.fusion.resolved_held_back = self.retry_held_back(&mut record);
-        record.seconds.map = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        record.metrics = self.refresh_metrics();
-        record.seconds.metrics = start.elapsed().as_secs_f64();
-        record
+        self.audit(record);
+        record.seconds.map += start.elapsed().as_secs_f64();
+        if fused {
+            counts
+        } else {
+            (0, 0)
+        }
+    }
+
+    /// The frames station `index` registers against, each with the station it is the frame
+    /// of (none for the sketch): the sketch's, and those of the [`RECENT_FRAMES`] stations
+    /// nearest in the drive among the recent ones that fused enough landmarks, oldest first.
+    /// For the station being mapped the nearest are the latest; a stalled station revisited
+    /// later ([`Mapper::revisit_stalled`]) takes those on either side of it.
+    fn frames(&self, index: usize) -> (Vec<Option<usize>>, Vec<Frame>) {
+        let mut recent: Vec<&Sighted> = self
+            .recent(index)
+            .iter()
+            .filter(|s| s.station != index && s.frame.registrable())
+            .collect();
+        recent.sort_by_key(|s| (s.station.abs_diff(index), std::cmp::Reverse(s.station)));
+        recent.truncate(RECENT_FRAMES);
+        recent.sort_by_key(|s| s.station);
+        std::iter::once((None, self.sketch.frame(index)))
+            .filter(|(_, frame)| frame.registrable())
+            .chain(recent.iter().map(|s| (Some(s.station), s.frame.clone())))
+            .unzip()
+    }
+
+    /// Maps again each stalled station (one whose detections registered against nothing and
+    /// were all held back, then given up: [`Stalled`]) within the sketch's window before the
+    /// current one whose map has changed since it was last tried, now that later stations
+    /// may give it frames to register against; the first pass's decisions stand unless the
+    /// new association anchors a detection. The record of the current station lists what
+    /// they fused (`fusion.revisited`); a stalled station's own record keeps its first
+    /// decisions.
+    fn revisit_stalled(&mut self, record: &mut StationRecord) {
+        let current = record.index;
+        self.stalled.retain(|s| current <= s.index + sketch::WINDOW);
+        // A revisit that fuses changes the map and may unstick the others.
+        loop {
+            let Some(k) = self
+                .stalled
+                .iter()
+                .rposition(|s| s.revision != self.revision)
+            else {
+                return;
+            };
+            let stalled = self.stalled.remove(k);
+            match self.revisit(&stalled) {
+                Some(revisit) => {
+                    // Its first pass gave up every held-back detection.
+                    self.expired -= stalled.held;
+                    record.fusion.revisited.extend(
+                        revisit
+                            .detections
+                            .iter()
+                            .enumerate()
+                            .filter_map(|(detection, d)| match d.association {
+                                Association::Matched { landmark }
+                                | Association::New { landmark } => Some(LateSighting {
+                                    station: stalled.index,
+                                    detection,
+                                    landmark,
+                                }),
+                                _ => None,
+                            }),
+                    );
+                    record.fusion.recognised.extend(revisit.fusion.recognised);
+                    record.fusion.splits.extend(revisit.fusion.splits);
+                    record.warnings.extend(revisit.warnings);
+                }
+                None => self.stalled.insert(
+                    k,
+                    Stalled {
+                        revision: self.revision,
+                        ..stalled
+                    },
+                ),
+            }
+        }
+    }
+
+    /// Maps the stalled station again if association now anchors any of its detections:
+    /// returns its scratch record, whose detections carry the new decisions.
+    fn revisit(&mut self, stalled: &Stalled) -> Option<StationRecord> {
+        let decided = self.decide(
+            stalled.index,
+            &stalled.station,
+            &stalled.ranged,
+            stalled.usable.clone(),
+        );
+        if !decided
+            .associated
+            .decisions
+            .iter()
+            .any(|d| matches!(d, Decision::Matched(_)))
+        {
+            return None;
+        }
+        let mut scratch = StationRecord {
+            index: stalled.index,
+            station: stalled.station.name.clone(),
+            detections: self.detection_records(&stalled.station, &stalled.ranged),
+            ..StationRecord::default()
+        };
+        self.fuse_decided(
+            &mut scratch,
+            &stalled.station,
+            stalled.ranged.clone(),
+            decided,
+        );
+        Some(scratch)
     }
 
     /// The decisions with every match whose landmark an earlier station (within the sketch's
@@ -513,7 +710,7 @@ impl<C: Calculus> Mapper<C> {
         };
         self.sketch
             .update(record.index, &frame.landmarks, &frame.unmapped);
-        self.sighted.push(Sighted {
+        let sighted = Sighted {
             station: record.index,
             bearings: associated
                 .fused
@@ -521,7 +718,13 @@ impl<C: Calculus> Mapper<C> {
                 .map(|s| (s.landmark, view.bearings[s.position]))
                 .collect(),
             frame,
-        });
+        };
+        // In drive order: a revisited station takes its first pass's place.
+        let at = self.sighted.partition_point(|s| s.station < record.index);
+        match self.sighted.get_mut(at) {
+            Some(s) if s.station == record.index => *s = sighted,
+            _ => self.sighted.insert(at, sighted),
+        }
     }
 
     /// Splits every landmark fused at this station whose placement here an earlier station
@@ -530,11 +733,7 @@ impl<C: Calculus> Mapper<C> {
     /// that recent stations contradict; what is left are sightings whose disagreement only
     /// a station that shares enough landmarks with both can tell.
     fn audit(&mut self, record: &mut StationRecord) {
-        let Some((current, earlier)) = self
-            .sighted
-            .split_last()
-            .filter(|(current, _)| current.station == record.index)
-        else {
+        let Some(current) = self.sighted.iter().find(|s| s.station == record.index) else {
             return;
         };
         let contradicted: Vec<LandmarkId> = current
@@ -543,8 +742,9 @@ impl<C: Calculus> Mapper<C> {
             .iter()
             .map(|m| m.0)
             .filter(|&l| {
-                earlier
+                self.sighted
                     .iter()
+                    .filter(|s| s.station != record.index)
                     .any(|s| agreement::witness(&s.frame, &current.frame, l) == Some(false))
             })
             .collect();

@@ -174,6 +174,11 @@ pub struct FusionRecord {
     /// station's record keeps the decision made when it was mapped.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub recognised: Vec<LateSighting>,
+    /// Detections of earlier stalled panoramas (whose detections registered against nothing
+    /// and were all given up) fused once this one gave them frames to register against
+    /// (`Mapper::revisit_stalled`). The earlier station's record keeps its first decisions.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub revisited: Vec<LateSighting>,
     /// Why the map rejected the panorama, if it did.
     pub contradiction: Option<String>,
     /// Landmarks found, once this panorama was fused, to mix rocks, and split.
