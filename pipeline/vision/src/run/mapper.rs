@@ -463,6 +463,21 @@ impl<C: Calculus> Mapper<C> {
         {
             return None;
         }
+        // A station stalls where its view is hard to place (a sharp turn, a long step), and
+        // the audit, which compares it with every station that placed its landmarks, would
+        // take a placement error of its own for a wrong match and retire every sighting of
+        // the landmark (stress seed 17, station 41 revisited: 9 matches, all right; the
+        // audit then retired 21 stations' sightings of one). Its matches must agree with
+        // every station's placements before anything of it is fused.
+        let frame = decided.associated.frame();
+        let disputed = frame.landmarks.iter().any(|&(l, _)| {
+            self.sighted.iter().any(|s| {
+                s.station != stalled.index && agreement::witness(&s.frame, &frame, l) == Some(false)
+            })
+        });
+        if disputed {
+            return None;
+        }
         let mut scratch = StationRecord {
             index: stalled.index,
             station: stalled.station.name.clone(),
@@ -698,16 +713,7 @@ impl<C: Calculus> Mapper<C> {
                 },
             };
         }
-        let frame = Frame {
-            accumulated: false,
-            departed: Vec::new(),
-            unmapped: associated.unmapped(),
-            landmarks: associated
-                .fused
-                .iter()
-                .filter_map(|s| Some((s.landmark, associated.evidence[s.position].placed?)))
-                .collect(),
-        };
+        let frame = associated.frame();
         self.sketch
             .update(record.index, &frame.landmarks, &frame.unmapped);
         let sighted = Sighted {
@@ -1062,6 +1068,20 @@ struct Associated {
 }
 
 impl Associated {
+    /// The station's frame: its fused landmarks and the rocks it left unmapped, placed.
+    fn frame(&self) -> Frame {
+        Frame {
+            accumulated: false,
+            departed: Vec::new(),
+            unmapped: self.unmapped(),
+            landmarks: self
+                .fused
+                .iter()
+                .filter_map(|s| Some((s.landmark, self.evidence[s.position].placed?)))
+                .collect(),
+        }
+    }
+
     /// The rocks the station saw that it fused into no landmark: detections held back or
     /// founding none, and those mapping does not use.
     fn unmapped(&self) -> Vec<Placed> {
