@@ -35,7 +35,7 @@ EXPECTED = {
     ),
     "/measurements": (
         {"index", "station", "files", "landmarks", "triples", "relations_tightened",
-         "resolved_held_back", "recognised", "contradiction", "warnings"},
+         "resolved_held_back", "recognised", "revisited", "contradiction", "warnings"},
         {},
     ),
     "/map_metrics": (

@@ -236,6 +236,7 @@ impl McapRecorder {
                 relations_tightened: f.relations_tightened,
                 resolved_held_back: f.resolved_held_back,
                 recognised: &f.recognised,
+                revisited: &f.revisited,
                 contradiction: f.contradiction.as_deref(),
                 warnings: &r.warnings,
             },
@@ -381,6 +382,7 @@ struct MeasurementsMessage<'a> {
     relations_tightened: usize,
     resolved_held_back: usize,
     recognised: &'a [LateSighting],
+    revisited: &'a [LateSighting],
     contradiction: Option<&'a str>,
     warnings: &'a [String],
 }

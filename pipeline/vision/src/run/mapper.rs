@@ -108,8 +108,8 @@ struct Stalled {
     /// Its detections' range evidence before the size cue, and the usable ones.
     ranged: Vec<Ranged>,
     usable: Vec<usize>,
-    /// How many of its detections were held back, and given up.
-    held: usize,
+    /// Its held-back detections (indices into its detections), all given up.
+    held: Vec<usize>,
     /// The map's revision when it was last tried.
     revision: u64,
 }
@@ -239,12 +239,20 @@ impl<C: Calculus> Mapper<C> {
             return record;
         }
 
-        let (fused, held) = self.map_station(&mut record, station, ranged.clone(), usable.clone());
+        let fused = self.map_station(&mut record, station, ranged.clone(), usable.clone());
         let start = Instant::now();
         self.revisit_stalled(&mut record);
         record.fusion.resolved_held_back = self.retry_held_back(&mut record);
         // Its held-back detections, with no fused partner to be measured with, were given up.
-        if fused == 0 && held > 0 {
+        let held: Vec<usize> = (0..record.detections.len())
+            .filter(|&i| {
+                matches!(
+                    record.detections[i].association,
+                    Association::HeldBack { .. }
+                )
+            })
+            .collect();
+        if fused == 0 && !held.is_empty() {
             self.stalled.push(Stalled {
                 index,
                 station: station.clone(),
@@ -284,14 +292,14 @@ impl<C: Calculus> Mapper<C> {
 
     /// Associates and fuses the usable detections of station `record.index`: the record gets
     /// their decisions, fusion outcome and the stage times of association and mapping.
-    /// Returns how many detections were fused and held back.
+    /// Returns how many detections were fused.
     fn map_station(
         &mut self,
         record: &mut StationRecord,
         station: &StationDetections,
         ranged: Vec<Ranged>,
         usable: Vec<usize>,
-    ) -> (usize, usize) {
+    ) -> usize {
         let start = Instant::now();
         let decided = self.decide(record.index, station, &ranged, usable);
         record.seconds.associate += start.elapsed().as_secs_f64();
@@ -331,15 +339,15 @@ impl<C: Calculus> Mapper<C> {
         }
     }
 
-    /// Fuses a station's decided detections; returns how many were fused and held back (none
-    /// when the map rejected the panorama).
+    /// Fuses a station's decided detections; returns how many were fused (none when the map
+    /// rejected the panorama).
     fn fuse_decided(
         &mut self,
         record: &mut StationRecord,
         station: &StationDetections,
         mut ranged: Vec<Ranged>,
         decided: Decided,
-    ) -> (usize, usize) {
+    ) -> usize {
         let start = Instant::now();
         let Decided {
             associated,
@@ -352,7 +360,7 @@ impl<C: Calculus> Mapper<C> {
                 };
             }
         }
-        let counts = (associated.fused.len(), associated.held.len());
+        let count = associated.fused.len();
         self.apply_size_cue(station, &mut ranged, &associated);
         for (i, r) in ranged.iter().enumerate() {
             record.detections[i].range = detection_record(&station.primary[i], r).range;
@@ -366,9 +374,9 @@ impl<C: Calculus> Mapper<C> {
         self.audit(record);
         record.seconds.map += start.elapsed().as_secs_f64();
         if fused {
-            counts
+            count
         } else {
-            (0, 0)
+            0
         }
     }
 
@@ -414,8 +422,20 @@ impl<C: Calculus> Mapper<C> {
             let stalled = self.stalled.remove(k);
             match self.revisit(&stalled) {
                 Some(revisit) => {
-                    // Its first pass gave up every held-back detection.
-                    self.expired -= stalled.held;
+                    // Its first pass gave up every held-back detection; those held back again
+                    // are counted when they are resolved or given up, those it now leaves out
+                    // stay given up.
+                    self.expired -= stalled.held.len();
+                    self.expired += stalled
+                        .held
+                        .iter()
+                        .filter(|&&i| {
+                            matches!(
+                                revisit.detections[i].association,
+                                Association::Unused { .. }
+                            )
+                        })
+                        .count();
                     record.fusion.revisited.extend(
                         revisit
                             .detections

@@ -37,6 +37,16 @@ pub struct RunSummary {
     #[serde(default)]
     pub recognised_held_back: usize,
     pub pending_held_back: usize,
+    /// Held back at a stalled station (one whose detections registered against nothing) and
+    /// fused when a later station's frames let it be mapped again (`Mapper::revisit_stalled`).
+    #[serde(default)]
+    pub revisited_held_back: usize,
+    /// Stalled stations mapped again, and the sightings they added (detections held back or
+    /// left out at first).
+    #[serde(default)]
+    pub stations_revisited: usize,
+    #[serde(default)]
+    pub revisited_sightings: usize,
     /// Held back and given up (waited too long, or their station had too few fused partners).
     pub expired_held_back: usize,
     pub rng_certain: usize,
@@ -101,6 +111,7 @@ impl RunSummary {
             .map(|r| r.metrics.clone())
             .unwrap_or_default();
         let sum = |f: fn(&StationRecord) -> f64| records.iter().map(f).sum::<f64>();
+        let revisited = || records.iter().flat_map(|r| &r.fusion.revisited);
         RunSummary {
             stations: records.len(),
             stations_skipped: skipped,
@@ -127,6 +138,21 @@ impl RunSummary {
             resolved_held_back: records.iter().map(|r| r.fusion.resolved_held_back).sum(),
             recognised_held_back: records.iter().map(|r| r.fusion.recognised.len()).sum(),
             pending_held_back: mapper.held_back(),
+            revisited_held_back: revisited()
+                .filter(|l| {
+                    matches!(
+                        records[l.station].detections[l.detection].association,
+                        Association::HeldBack { .. }
+                    )
+                })
+                .count(),
+            stations_revisited: {
+                let mut stations: Vec<usize> = revisited().map(|l| l.station).collect();
+                stations.sort_unstable();
+                stations.dedup();
+                stations.len()
+            },
+            revisited_sightings: revisited().count(),
             expired_held_back: mapper.expired,
             rng_certain: last.rng_certain,
             rng_uncertain: last.rng_uncertain,
@@ -182,15 +208,23 @@ impl fmt::Display for RunSummary {
         )?;
         writeln!(
             f,
-            "contradictions: {}; landmarks split: {}; held back: {} ({} resolved by re-test, {} recognised at later stations, {} given up, {} pending)",
+            "contradictions: {}; landmarks split: {}; held back: {} ({} resolved by re-test, {} recognised at later stations, {} fused when their station was revisited, {} given up, {} pending)",
             self.contradictions,
             self.landmarks_split,
             self.held_back,
             self.resolved_held_back,
             self.recognised_held_back,
+            self.revisited_held_back,
             self.expired_held_back,
             self.pending_held_back
         )?;
+        if self.stations_revisited > 0 {
+            writeln!(
+                f,
+                "{} stalled stations (registered against nothing at first) mapped again once later stations gave them frames: {} sightings",
+                self.stations_revisited, self.revisited_sightings
+            )?;
+        }
         if let Some(b) = &self.beliefs {
             writeln!(
                 f,
