@@ -1,6 +1,7 @@
 //! The mapping half of `pipeline run`: station by station, range evidence and association
 //! (000 §VI-C) turn detections into measurements, fused into the map (000 §VI-B); held-back
-//! observations are retried after every station.
+//! observations are retried after every station, and stations that registered against
+//! nothing are mapped again when later stations change the map.
 
 use super::record::{
     Association, DetectionRecord, Exclusion, LateSighting, MetricsRecord, RangeRecord, SplitRecord,
@@ -510,6 +511,11 @@ impl<C: Calculus> Mapper<C> {
             stalled.ranged.clone(),
             decided,
         );
+        // What its first pass left out and the revisit did not fuse stays out: only what was
+        // held back then waits again, so that every held-back detection is counted once.
+        self.held.retain(|item| {
+            item.station != stalled.index || stalled.held.contains(&item.primary_index)
+        });
         Some(scratch)
     }
 
