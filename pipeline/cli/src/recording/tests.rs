@@ -12,7 +12,8 @@ use serde_json::Value;
 use super::*;
 use qrm_vision::detection::Channels;
 use qrm_vision::run::{
-    Association, DetectionRecord, Exclusion, FusionRecord, MetricsRecord, RangeRecord, StageSeconds,
+    Association, DetectionRecord, Exclusion, FusionRecord, LateSighting, MetricsRecord,
+    RangeRecord, StageSeconds,
 };
 
 const STATIONS: usize = 16;
@@ -89,6 +90,14 @@ fn station(index: usize) -> StationRecord {
             relations_tightened: index,
             resolved_held_back: index % 2,
             recognised: Vec::new(),
+            revisited: (index == 3)
+                .then_some(LateSighting {
+                    station: 1,
+                    detection: 0,
+                    landmark: 2,
+                })
+                .into_iter()
+                .collect(),
             contradiction: (index == 5).then(|| "triple (1, 2, 3) emptied".to_string()),
             splits: Vec::new(),
         },
