@@ -426,7 +426,8 @@ impl<C: Calculus> Mapper<C> {
                     // Its first pass gave up every held-back detection; those held back again
                     // are counted when they are resolved or given up, those it now leaves out
                     // stay given up.
-                    self.expired -= stalled.held.len();
+                    debug_assert!(self.expired >= stalled.held.len());
+                    self.expired = self.expired.saturating_sub(stalled.held.len());
                     self.expired += stalled
                         .held
                         .iter()
