@@ -16,7 +16,7 @@ use qrm_core::map::LandmarkId;
 /// How one landmark's sightings are shared out once some are found to show another rock:
 /// `groups[0]` keeps the landmark, each further group becomes a landmark of its own, and the
 /// sightings of `retired` stations leave the map (stations whose sightings disagree with
-/// others they agree with: no rock can be told for them; or an outlier alone, [`outliers`]).
+/// others they agree with: no rock can be told for them; or an outlier alone, `outliers`).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Regrouping {
     pub landmark: LandmarkId,
@@ -29,7 +29,7 @@ pub struct Regrouping {
 /// fused, if two of them disagree on where it is ([`witness`]). Sightings that agree, directly
 /// or through others, show one rock; the largest such set keeps the landmark, and a set that
 /// disagrees with every group so far starts another. A set that disagrees with itself leaves
-/// the map, or only its outlier does, when it has one ([`outliers`]). A sighting no other
+/// the map, or only its outlier does, when it has one (`outliers`). A sighting no other
 /// station can witness goes with the nearest one in time that is witnessed: association
 /// tracked it from there.
 pub fn regroup(landmark: LandmarkId, sightings: &[(usize, &Frame)]) -> Option<Regrouping> {
