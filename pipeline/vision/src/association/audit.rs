@@ -137,7 +137,7 @@ const OUTLIER_DISAGREEMENTS: usize = 2;
 /// rock 1. In three of the four such groups the outlier was the wrong sighting (a 26 000-pixel
 /// blob of shadow under rock 19 recognised as its landmark, rock 1's sighting, a blob over
 /// three rocks), in the fourth a small far sighting of the right rock. A single disagreement
-/// says nothing of which side is wrong (in 4 of 8 such groups the two sightings were of
+/// says nothing of which side is wrong (in 5 of 8 such groups the two sightings were of
 /// different rocks, with up to 7 more wrong sightings that agreed with the rest, as in a pile
 /// of rocks a metre apart), so its group still leaves the map whole.
 fn outliers(component: &[usize], disagree: &[(usize, usize)]) -> Vec<usize> {
