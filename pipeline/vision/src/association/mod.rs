@@ -332,9 +332,13 @@ pub fn associate<C: Calculus>(
     );
     // The station's usable detections' rays lead `seen`.
     let rays = &seen[..n];
+    let alike = |i: usize, l: LandmarkId| looks_alike(&candidates, i, l);
     let elsewhere = unplaced_rays(station, &firm);
     for (frame, registration) in &mut registrations {
         registration.drop_pairs_seen_elsewhere(frame, &firm, rays, &elsewhere);
+        if !station.colour {
+            registration.drop_ambiguous_pairs(frame, &placed, &alike);
+        }
     }
     // The dropped pairs' landmarks may be other rocks, so they no longer support the motion:
     // fewer than the fewest believed left, and the fit is not trusted (the 1 000-rock drive,
@@ -345,7 +349,6 @@ pub fn associate<C: Calculus>(
     // Where nothing placed was seen: the directions an observer's landmark must not lie in
     // (the others' pairs passed this test with the observers' directions too).
     let unplaced = unplaced_rays(station, &placed);
-    let alike = |i: usize, l: LandmarkId| looks_alike(&candidates, i, l);
     for (frame, registration) in &mut registrations {
         registration.pair_observers(frame, &placed, &observers, &alike);
         registration.drop_pairs_seen_elsewhere(frame, &placed, rays, &unplaced);
@@ -355,7 +358,14 @@ pub fn associate<C: Calculus>(
     } else {
         settings.min_support_without_colour
     };
-    let mut anchors = anchors(&registrations, &candidates, &placed, &doubtful, min_support);
+    let mut anchors = anchors(
+        &registrations,
+        &candidates,
+        &placed,
+        &doubtful,
+        min_support,
+        !station.colour,
+    );
     let candidates = placed_near(candidates, &registrations, &placed);
     drop_inconsistent_anchors(map, view, &mut anchors);
     let anchored: Vec<Sighting> = anchors.iter().map(|a| Sighting::new(a.0, a.1)).collect();
@@ -589,6 +599,7 @@ fn anchors(
     placed: &[Option<Placed>],
     doubtful: &[bool],
     min_support: usize,
+    fragmented: bool,
 ) -> Vec<(usize, LandmarkId, f64)> {
     let mut pairs: Vec<(usize, LandmarkId)> = registrations
         .iter()
@@ -644,6 +655,7 @@ fn anchors(
                     placed[i],
                     l,
                     &others(i),
+                    fragmented,
                 ))
     };
     pairs
@@ -732,6 +744,7 @@ fn long_anchor(
     placed: Option<Placed>,
     l: LandmarkId,
     others: &[Placed],
+    fragmented: bool,
 ) -> bool {
     let Some(p) = placed else {
         return false;
@@ -741,7 +754,7 @@ fn long_anchor(
         && supporting.iter().any(|(frame, _)| !frame.accumulated)
         && supporting
             .iter()
-            .all(|(frame, r)| !r.crowded(frame, &p, l, others))
+            .all(|(frame, r)| !r.crowded(frame, &p, l, others, fragmented))
 }
 
 /// Re-tests one held-back detection of an earlier station against the current map (000 §VI-C
@@ -1313,12 +1326,12 @@ mod tests {
             (&near, by_sketch.clone()),
         ];
         assert_eq!(
-            anchors(&registrations, &candidates, &placed, &[false], 1),
+            anchors(&registrations, &candidates, &placed, &[false], 1, false),
             vec![(0, 0, 0.1)]
         );
         let far = sketch([20.0, 10.0]);
         let registrations = [(&station_frame, by_frame), (&far, by_sketch)];
-        assert!(anchors(&registrations, &candidates, &placed, &[false], 1).is_empty());
+        assert!(anchors(&registrations, &candidates, &placed, &[false], 1, false).is_empty());
     }
 
     /// A far rock's detection, placed 3 m deep along its bearing, anchors to the landmark two
@@ -1336,7 +1349,7 @@ mod tests {
         let landmark = frame(&[[10.0, 0.0]]);
         let anchored = |second: &Frame| {
             let registrations = [(&landmark, pairing.clone()), (second, pairing.clone())];
-            !anchors(&registrations, &candidates, &placed, &[false], 1).is_empty()
+            !anchors(&registrations, &candidates, &placed, &[false], 1, false).is_empty()
         };
         assert!(anchored(&landmark));
         assert!(anchors(
@@ -1344,7 +1357,8 @@ mod tests {
             &candidates,
             &placed,
             &[false],
-            1
+            1,
+            false
         )
         .is_empty());
         assert!(!anchored(&frame(&[[10.0, 0.0], [12.0, 0.0]])));
@@ -1361,7 +1375,15 @@ mod tests {
                 (&unmapped([12.0, 0.0]), pairing.clone()),
             ];
             let placed = [placed[0], Some(Placed::along(other, 0.0, 0.3, 0.1))];
-            !anchors(&registrations, &candidates, &placed, &[false, false], 1).is_empty()
+            !anchors(
+                &registrations,
+                &candidates,
+                &placed,
+                &[false, false],
+                1,
+                false,
+            )
+            .is_empty()
         };
         assert!(beside_it([12.2, 0.0]));
         assert!(!beside_it([20.0, 0.0]), "the other detection is elsewhere");
@@ -1372,12 +1394,13 @@ mod tests {
             &candidates,
             &near,
             &[false],
-            1
+            1,
+            false
         )
         .is_empty());
         // A detection the detector doubts anchors, however near, only as a far rock does.
         let doubtful = |registrations: &[(&Frame, Registration)]| {
-            !anchors(registrations, &candidates, &near, &[true], 1).is_empty()
+            !anchors(registrations, &candidates, &near, &[true], 1, false).is_empty()
         };
         assert!(!doubtful(&[(&landmark, pairing.clone())]));
         assert!(doubtful(&[
@@ -1584,7 +1607,7 @@ mod tests {
             (0..4).map(|i| vec![(i as LandmarkId, 0.1)]).collect();
         let placed: Vec<Option<Placed>> = FIELD[..4].iter().map(|&p| Some(at(p))).collect();
         let anchored = |registrations: &[(&Frame, Registration)]| -> Vec<usize> {
-            anchors(registrations, &candidates, &placed, &[false; 4], 1)
+            anchors(registrations, &candidates, &placed, &[false; 4], 1, false)
                 .iter()
                 .map(|a| a.0)
                 .collect()

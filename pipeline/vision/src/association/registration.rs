@@ -10,7 +10,7 @@
 //! *proposes*: the qualitative test of 000 §VI-C decides (`super::associate`).
 
 use super::disc_grid::DiscGrid;
-use super::placement::{bound_of_sum, separation_of, turned_shape, Placed, Separation};
+use super::placement::{bound_of_sum, separation, separation_of, turned_shape, Placed, Separation};
 use super::significance::Chance;
 use crate::ranging::Ray;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
@@ -568,6 +568,31 @@ impl Registration {
         self.pairs.extend(added);
     }
 
+    /// Drops the pairs whose landmark lies within reach of another placed detection of the
+    /// station (`placed`, observers included) that looks like it (`alike`), not clearly
+    /// farther than the pair's own: the fit's own test ([`unambiguous_pair`]) sees only the
+    /// detections that steer it.
+    pub fn drop_ambiguous_pairs(
+        &mut self,
+        frame: &Frame,
+        placed: &[Option<Placed>],
+        alike: &dyn Fn(usize, LandmarkId) -> bool,
+    ) {
+        let motion = self.motion();
+        self.pairs.retain(|&(i, l)| {
+            let (Some(p), Some((_, q))) = (placed[i], frame.landmarks.iter().find(|m| m.0 == l))
+            else {
+                return true;
+            };
+            let near = UNIQUE * motion.separation(&p, q).distance + SLACK_M;
+            placed.iter().enumerate().all(|(k, other)| {
+                k == i
+                    || !alike(k, l)
+                    || other.is_none_or(|o| motion.separation(&o, q).distance > near)
+            })
+        });
+    }
+
     /// Drops the pairs whose landmark, brought back into the current station by the motion,
     /// lies in a direction nearer to where one of the station's detections without a placement
     /// was seen (its ray in `elsewhere`, at the landmark's range) than to its paired
@@ -654,26 +679,40 @@ impl Registration {
     /// grayscale marsyard seed 3 0.991 → 0.986. Letting those pass that another detection
     /// accounts for: grayscale marsyard seed 7 33.3 → 43.7 % fused, no set of 15 lower by
     /// more than 0.2 points, purity unchanged, docs/RUN.md.)
-    pub fn crowded(&self, frame: &Frame, p: &Placed, l: LandmarkId, others: &[Placed]) -> bool {
+    pub fn crowded(
+        &self,
+        frame: &Frame,
+        p: &Placed,
+        l: LandmarkId,
+        others: &[Placed],
+        fragmented: bool,
+    ) -> bool {
         let motion = self.motion();
-        let other_landmark = frame
+        let unaccounted = |g: &Placed| {
+            let ours = motion.separation(p, g);
+            ours.within()
+                && !others.iter().any(|o| {
+                    let theirs = motion.separation(o, g);
+                    theirs.within() && theirs.distance < ours.distance
+                })
+        };
+        frame
             .landmarks
             .iter()
             .filter(|m| m.0 != l)
-            .any(|m| motion.separation(p, &m.1).within());
-        other_landmark
+            .any(|m| unaccounted(&m.1))
             || frame
                 .unmapped
                 .iter()
                 .filter(|g| g.reach() <= LONG_ANCHOR_RADIUS_M)
-                .any(|g| {
-                    let ours = motion.separation(p, g);
-                    ours.within()
-                        && !others.iter().any(|o| {
-                            let theirs = motion.separation(o, g);
-                            theirs.within() && theirs.distance < ours.distance
-                        })
+                .filter(|g| {
+                    !fragmented
+                        || !frame
+                            .landmarks
+                            .iter()
+                            .any(|m| m.0 == l && separation(g, &m.1, SLACK_M).within())
                 })
+                .any(unaccounted)
     }
 
     /// The frame's unmapped rock (index into [`Frame::unmapped`]) that the current station's
@@ -1332,6 +1371,67 @@ pub(super) mod tests {
         };
         assert_eq!(paired(&|_, _| true), [(4, 4)]);
         assert_eq!(paired(&|i, _| i != 4), []);
+    }
+
+    /// A pair is dropped when another placed detection that looks like its landmark, an
+    /// observer the fit never saw, lies as near the landmark; one that looks otherwise, or
+    /// lies clearly farther, leaves it.
+    #[test]
+    fn a_pair_an_observer_lies_as_near_is_dropped() {
+        let frame = field_frame();
+        let registration = Registration {
+            pairs: (0..4).map(|k| (k, k as LandmarkId)).collect(),
+            motion: [1.0, 0.0, 0.0, 0.0],
+            nfa: 0.0,
+        };
+        let kept = |observer: [f64; 2], alike: &dyn Fn(usize, LandmarkId) -> bool| {
+            let mut placed: Vec<Option<Placed>> = FIELD[..4]
+                .iter()
+                .map(|&p| Some(Placed::disc(p, 0.3)))
+                .collect();
+            placed.push(Some(Placed::disc(observer, 0.3)));
+            let mut r = registration.clone();
+            r.drop_ambiguous_pairs(&frame, &placed, alike);
+            r.pairs
+        };
+        let all: Vec<(usize, LandmarkId)> = (0..4).map(|k| (k, k as LandmarkId)).collect();
+        assert_eq!(kept([3.2, 1.1], &|_, _| true), all[1..]);
+        assert_eq!(kept([3.2, 1.1], &|i, _| i != 4), all);
+        assert_eq!(kept([4.5, 2.5], &|_, _| true), all);
+    }
+
+    /// By luminance (`fragmented`), an unmapped rock within the paired landmark's own
+    /// placement is taken for a piece of its rock and crowds nothing; in colour it crowds, as
+    /// does one beside the landmark, and another landmark, unless another detection of the
+    /// station lies nearer to it.
+    #[test]
+    fn an_unmapped_rock_within_the_landmark_crowds_only_in_colour() {
+        let identity = Registration {
+            pairs: vec![(0, 0)],
+            motion: [1.0, 0.0, 0.0, 0.0],
+            nfa: 0.0,
+        };
+        let p = Placed::along([10.0, 0.0], 0.0, 3.0, 0.1);
+        let frame = |unmapped: [f64; 2], other: [f64; 2]| Frame {
+            accumulated: true,
+            departed: Vec::new(),
+            unmapped: vec![Placed::disc(unmapped, 0.3)],
+            landmarks: vec![
+                (0, Placed::disc([10.0, 0.0], 0.3)),
+                (1, Placed::disc(other, 0.3)),
+            ],
+        };
+        let crowded = |f: &Frame, fragmented: bool, others: &[Placed]| {
+            identity.crowded(f, &p, 0, others, fragmented)
+        };
+        let within = frame([10.2, 0.0], [30.0, 0.0]);
+        assert!(!crowded(&within, true, &[]));
+        assert!(crowded(&within, false, &[]));
+        let beside = frame([11.5, 0.0], [30.0, 0.0]);
+        assert!(crowded(&beside, true, &[]));
+        let landmark = frame([30.0, 0.0], [11.5, 0.0]);
+        assert!(crowded(&landmark, true, &[]));
+        assert!(!crowded(&landmark, true, &[Placed::disc([11.6, 0.0], 0.3)]));
     }
 
     /// FIELD seen from a station at `at`, turned by `turn`: each rock in that station's frame,
