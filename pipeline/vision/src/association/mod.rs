@@ -336,6 +336,7 @@ pub fn associate<C: Calculus>(
     let elsewhere = unplaced_rays(station, &firm);
     for (frame, registration) in &mut registrations {
         registration.drop_pairs_seen_elsewhere(frame, &firm, rays, &elsewhere);
+        // By luminance an uncorroborated piece observes: the fit's test never saw it.
         if !station.colour {
             registration.drop_ambiguous_pairs(frame, &placed, &alike);
         }
