@@ -696,9 +696,10 @@ impl Registration {
     /// with it and refused, 216 of them with a crowded frame). Over 14 luminance sets, 3 638
     /// sightings passed through this rule to the right rock's landmark and 88 to another,
     /// 39 of those in the rock piles of stress seeds 9 and 12, where a landmark already held
-    /// two rocks (docs/RUN.md, stop 68). In colour a piece steers the fit like any detection,
-    /// and an unmapped rock there is more often another rock: allowed in colour, stress
-    /// seed 4's piles took purity from 0.955 to 0.923.
+    /// two rocks (docs/RUN.md, stop 68). In colour a piece steers the fit like any detection
+    /// and far fewer are held back (marsyard seed 3: 197 held back, against 579 by
+    /// luminance); allowed there, the rule took stress seed 4's purity from 0.955 to 0.923
+    /// (piles of overlapping rocks).
     pub fn crowded(
         &self,
         frame: &Frame,
