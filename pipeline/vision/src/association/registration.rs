@@ -570,7 +570,7 @@ impl Registration {
 
     /// Drops the pairs whose landmark lies within reach of another placed detection of the
     /// station (`placed`, observers included) that looks like it (`alike`), not clearly
-    /// farther than the pair's own: the fit's own test ([`unambiguous_pair`]) sees only the
+    /// farther than the pair's own: the fit's own test (`unambiguous_pair`) sees only the
     /// detections that steer it, and by luminance an uncorroborated piece does not steer.
     /// JPEG marsyard seed 11, station 39 (with observers anchoring past crowded frames): rock
     /// 20's piece paired with the landmark a blob of rocks 12 and 20 had founded, while rock
