@@ -521,9 +521,22 @@ fn unambiguous_pair(
         && p.reach() <= LONG_ANCHOR_RADIUS_M
         && (0..frame.landmarks.len())
             .all(|k| k == j || motion.separation(&p, &frame.landmarks[k].1).distance > near)
-        && current.iter().enumerate().all(|(k, other)| {
-            k == i || other.is_none_or(|o| motion.separation(&o, &q).distance > near)
-        })
+        && others_farther(motion, current, i, &q, near, |_| true)
+}
+
+/// Whether every placed detection of `placed` but `i` that `counts` lies farther than `near`
+/// from the landmark placed at `q`, under `motion`.
+fn others_farther(
+    motion: &Motion,
+    placed: &[Option<Placed>],
+    i: usize,
+    q: &Placed,
+    near: f64,
+    counts: impl Fn(usize) -> bool,
+) -> bool {
+    placed.iter().enumerate().all(|(k, other)| {
+        k == i || !counts(k) || other.is_none_or(|o| motion.separation(&o, q).distance > near)
+    })
 }
 
 impl Registration {
@@ -591,11 +604,7 @@ impl Registration {
                 return true;
             };
             let near = UNIQUE * motion.separation(&p, q).distance + SLACK_M;
-            placed.iter().enumerate().all(|(k, other)| {
-                k == i
-                    || !alike(k, l)
-                    || other.is_none_or(|o| motion.separation(&o, q).distance > near)
-            })
+            others_farther(&motion, placed, i, q, near, |k| alike(k, l))
         });
     }
 
@@ -1368,6 +1377,15 @@ pub(super) mod tests {
         assert!(some.nfa(&residuals, MIN_INLIERS).0 < every.nfa(&residuals, MIN_INLIERS).0);
     }
 
+    /// Detections 0‥3 paired with landmarks 0‥3, with no motion.
+    fn first_four_in_place() -> Registration {
+        Registration {
+            pairs: (0..4).map(|k| (k, k as LandmarkId)).collect(),
+            motion: [1.0, 0.0, 0.0, 0.0],
+            nfa: 0.0,
+        }
+    }
+
     /// Under a registration of detections 0‥3 with landmarks 0‥3 (no motion), observers are
     /// paired with the landmark they lie clearly nearest to: detection 4 with landmark 4, and
     /// not detection 5, which lies as near landmark 5 as the undoubted detection 6 beside it,
@@ -1376,11 +1394,7 @@ pub(super) mod tests {
     #[test]
     fn observers_are_paired_under_the_motion_the_others_found() {
         let frame = field_frame();
-        let registration = Registration {
-            pairs: (0..4).map(|k| (k, k as LandmarkId)).collect(),
-            motion: [1.0, 0.0, 0.0, 0.0],
-            nfa: 0.0,
-        };
+        let registration = first_four_in_place();
         let mut points: Vec<[f64; 2]> = FIELD[..4].to_vec();
         points.extend([[8.1, 8.0], [-6.0, -3.2], [-6.0, -2.8], [3.0, 1.1]]);
         let placed: Vec<Option<Placed>> =
@@ -1400,11 +1414,7 @@ pub(super) mod tests {
     #[test]
     fn a_pair_an_observer_lies_as_near_is_dropped() {
         let frame = field_frame();
-        let registration = Registration {
-            pairs: (0..4).map(|k| (k, k as LandmarkId)).collect(),
-            motion: [1.0, 0.0, 0.0, 0.0],
-            nfa: 0.0,
-        };
+        let registration = first_four_in_place();
         let kept = |observer: [f64; 2], alike: &dyn Fn(usize, LandmarkId) -> bool| {
             let mut placed: Vec<Option<Placed>> = FIELD[..4]
                 .iter()
