@@ -632,7 +632,13 @@ fn anchors(
             // The sketch holds more look-alikes near each landmark than one station sees, so
             // its leaving a pair out is abstention, not doubt (counted as doubt, it cost 13 %
             // of random seed 5's sightings), unless its motion puts the detection far from
-            // the landmark: then the two registrations disagree on where the rover is.
+            // the landmark (then the two registrations disagree on where the rover is), or it
+            // knows another landmark where the detection is placed: with pieces ranged by
+            // their own pixels' shifts, marsyard seed 19, station 11, anchored rock 13 to a
+            // shadow's landmark 0.6 m from the rock's own on one station's frame while the
+            // sketch, holding both, paired it with neither (5 unsound relations). The
+            // sketch's unmapped rocks do not count: five stations of them crowd a random
+            // survey's placements (stress seed 13: 55.6 → 51.3 % fused with them).
             .filter(|(frame, r)| {
                 frame
                     .landmarks
@@ -641,7 +647,10 @@ fn anchors(
                     .is_some_and(|(_, q)| {
                         !frame.accumulated
                             || r.pairs.iter().any(|p| p.0 == i || p.1 == l)
-                            || placed[i].is_some_and(|p| !placed_as(frame, r, p, *q))
+                            || placed[i].is_some_and(|p| {
+                                !placed_as(frame, r, p, *q)
+                                    || r.crowded_by_landmarks(frame, &p, l, &others(i))
+                            })
                     })
             })
             .count();
@@ -1298,7 +1307,7 @@ mod tests {
     }
 
     #[test]
-    fn a_pair_the_sketch_places_far_apart_is_no_anchor() {
+    fn a_pair_the_sketch_places_far_apart_or_crowded_is_no_anchor() {
         // A station's frame pairs detection 0 with landmark 0. The sketch registered too and
         // left the pair out: abstention if its motion puts the detection near the landmark,
         // doubt if it puts it 19 m away (the two registrations disagree on where the rover is).
@@ -1331,8 +1340,31 @@ mod tests {
             vec![(0, 0, 0.1)]
         );
         let far = sketch([20.0, 10.0]);
-        let registrations = [(&station_frame, by_frame), (&far, by_sketch)];
+        let registrations = [
+            (&station_frame, by_frame.clone()),
+            (&far, by_sketch.clone()),
+        ];
         assert!(anchors(&registrations, &candidates, &placed, &[false], 1, false).is_empty());
+        // Near, but the sketch knows another landmark where the detection is: doubt. A rock
+        // it saw and did not map there is no landmark, and leaves it abstaining.
+        let crowded = Frame {
+            landmarks: vec![(0, at([3.5, 1.0])), (1, at([3.2, 0.8]))],
+            ..sketch([3.5, 1.0])
+        };
+        let registrations = [
+            (&station_frame, by_frame.clone()),
+            (&crowded, by_sketch.clone()),
+        ];
+        assert!(anchors(&registrations, &candidates, &placed, &[false], 1, false).is_empty());
+        let unmapped = Frame {
+            unmapped: vec![at([3.2, 0.8])],
+            ..sketch([3.5, 1.0])
+        };
+        let registrations = [(&station_frame, by_frame), (&unmapped, by_sketch)];
+        assert_eq!(
+            anchors(&registrations, &candidates, &placed, &[false], 1, false),
+            vec![(0, 0, 0.1)]
+        );
     }
 
     /// A far rock's detection, placed 3 m deep along its bearing, anchors to the landmark two

@@ -718,19 +718,7 @@ impl Registration {
         fragmented: bool,
     ) -> bool {
         let motion = self.motion();
-        let unaccounted = |g: &Placed| {
-            let ours = motion.separation(p, g);
-            ours.within()
-                && !others.iter().any(|o| {
-                    let theirs = motion.separation(o, g);
-                    theirs.within() && theirs.distance < ours.distance
-                })
-        };
-        frame
-            .landmarks
-            .iter()
-            .filter(|m| m.0 != l)
-            .any(|m| unaccounted(&m.1))
+        self.crowded_by_landmarks(frame, p, l, others)
             || frame
                 .unmapped
                 .iter()
@@ -742,7 +730,25 @@ impl Registration {
                             .iter()
                             .any(|m| m.0 == l && separation(g, &m.1, SLACK_M).within())
                 })
-                .any(unaccounted)
+                .any(|g| unaccounted(&motion, p, g, others))
+    }
+
+    /// Whether another landmark of the frame lies where the motion puts the placement `p`,
+    /// besides `l`, that none of the station's `others` placements accounts for: the landmark
+    /// half of [`Registration::crowded`].
+    pub fn crowded_by_landmarks(
+        &self,
+        frame: &Frame,
+        p: &Placed,
+        l: LandmarkId,
+        others: &[Placed],
+    ) -> bool {
+        let motion = self.motion();
+        frame
+            .landmarks
+            .iter()
+            .filter(|m| m.0 != l)
+            .any(|m| unaccounted(&motion, p, &m.1, others))
     }
 
     /// The frame's unmapped rock (index into [`Frame::unmapped`]) that the current station's
@@ -812,6 +818,18 @@ pub(super) fn unmapped_partner(motion: &Motion, p: &Placed, frame: &Frame) -> Op
         )
         .all(|o| motion.separation(p, o).distance > near);
     (separation.within() && frame.unmapped[g].reach() <= ANCHOR_RADIUS_M && alone).then_some(g)
+}
+
+/// Whether the frame's rock `g` lies where `motion` puts the placement `p`, and no placement
+/// of `others` accounts for it (lies nearer to it, within their separation: then it is that
+/// detection's rock).
+fn unaccounted(motion: &Motion, p: &Placed, g: &Placed, others: &[Placed]) -> bool {
+    let ours = motion.separation(p, g);
+    ours.within()
+        && !others.iter().any(|o| {
+            let theirs = motion.separation(o, g);
+            theirs.within() && theirs.distance < ours.distance
+        })
 }
 
 /// The displacement from an `earlier` station to a `later` one, seen from the earlier camera:

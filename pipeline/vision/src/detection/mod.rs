@@ -392,15 +392,25 @@ fn detect_in(
                     pixels: c,
                     part: Separation::Whole,
                     shifts: None,
+                    pixel_shifts: Vec::new(),
                 }],
             };
             layers.into_iter().map(move |layer| (blob as u32, layer))
         })
         .flat_map_iter(|(blob, layer)| {
-            let (part, shifts) = (layer.part, layer.shifts);
-            pieces(layer, rule)
-                .into_iter()
-                .map(move |piece| (blob, piece, part, shifts))
+            let parallax::Layer {
+                pixels,
+                part,
+                shifts,
+                pixel_shifts,
+            } = layer;
+            // A part separated by parallax has its shifts; a whole blob's pieces take theirs
+            // from its pixels'.
+            let lookup = parallax::ShiftLookup::new(&pixels, pixel_shifts);
+            pieces(pixels, part, rule).into_iter().map(move |piece| {
+                let shifts = shifts.or_else(|| lookup.range_of(&piece.pixels));
+                (blob, piece, part, shifts)
+            })
         })
         .filter_map(|(blob, piece, part, shifts)| {
             let pixels = blob_of(&piece.pixels, w, &sample);
@@ -614,14 +624,18 @@ fn max_shift(
 /// The pieces of one parallax layer: touching rocks cut at notches of the bottom edge. A
 /// farther layer is not cut: its bottom edge is the nearer rock's outline, notched where that
 /// outline rises, and the notch rule would cut the farther rock in two.
-fn pieces(layer: parallax::Layer, rule: split::SplitRule) -> Vec<split::Piece> {
-    if layer.part == Separation::Farther {
+fn pieces(
+    pixels: components::Component,
+    part: Separation,
+    rule: split::SplitRule,
+) -> Vec<split::Piece> {
+    if part == Separation::Farther {
         vec![split::Piece {
-            pixels: layer.pixels,
+            pixels,
             ambiguous: true,
         }]
     } else {
-        split::split(layer.pixels, rule)
+        split::split(pixels, rule)
     }
 }
 

@@ -10,7 +10,7 @@
 use super::components::{bounds, connected, Component, PixelIndex};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::collections::VecDeque;
+use std::collections::{HashMap, VecDeque};
 
 /// The other panorama of the stereo pair, for block matching.
 pub(super) struct Partner<'a> {
@@ -96,6 +96,34 @@ pub(super) struct Layer {
     /// For a separated part, the [`SHIFT_QUANTILES`] of its pixels' reliable shifts (columns):
     /// its own stereo evidence, since the other panorama's blob holds both parts.
     pub shifts: Option<[f32; 2]>,
+    /// For a blob matched and left whole, each pixel's shift, in the order of `pixels`
+    /// (empty if it was not matched): the pieces it is cut into take theirs ([`ShiftLookup`]).
+    pub pixel_shifts: Vec<Option<f32>>,
+}
+
+/// The shifts of a blob matched and left whole, by pixel, for the pieces it is cut into: a
+/// piece's own stereo evidence, since a piece touching another has no counterpart in the other
+/// panorama (`ranging::stereo::match_stereo` leaves it unpaired).
+pub(super) struct ShiftLookup(HashMap<(u32, u32), f32>);
+
+impl ShiftLookup {
+    /// The reliable shifts of `pixels`, given in the same order (`shifts` is empty for a blob
+    /// that was not matched).
+    pub fn new(pixels: &[(u32, u32)], shifts: Vec<Option<f32>>) -> ShiftLookup {
+        ShiftLookup(
+            pixels
+                .iter()
+                .zip(shifts)
+                .filter_map(|(&p, s)| Some((p, s?)))
+                .collect(),
+        )
+    }
+
+    /// The [`SHIFT_QUANTILES`] of `piece`'s reliable shifts, if it has any.
+    pub fn range_of(&self, piece: &[(u32, u32)]) -> Option<[f32; 2]> {
+        let own: Vec<Option<f32>> = piece.iter().map(|p| self.0.get(p).copied()).collect();
+        shift_range(&own)
+    }
 }
 
 /// The quantiles of a separated part's pixel shifts taken as its range of shifts: the
@@ -134,6 +162,7 @@ pub(super) fn layers(
             pixels,
             part: Separation::Whole,
             shifts: None,
+            pixel_shifts: Vec::new(),
         }];
     }
     let scale = if work > COARSE_WORK { 2 } else { 1 };
@@ -166,6 +195,7 @@ fn layers_at(
                     pixels,
                     part,
                     shifts: None,
+                    pixel_shifts: shifts,
                 });
             } else {
                 let range = shift_range(&shifts);
@@ -183,6 +213,7 @@ fn layers_at(
                             pixels,
                             part,
                             shifts: range,
+                            pixel_shifts: Vec::new(),
                         }),
                 );
             }
@@ -802,6 +833,42 @@ mod tests {
             layers(pixels, &partner(&own, &other, 1), 25, rule()).len(),
             1
         );
+    }
+
+    /// Two touching rocks at 15.9 m (shift 12) and 10.6 m (shift 18) in a blob left whole: each
+    /// piece the blob is cut into takes the shifts of its own pixels, not the blob's, which
+    /// span both ranges.
+    #[test]
+    fn the_pieces_of_a_whole_blob_take_their_own_shifts() {
+        let left = at_shift(1, ellipse(110.0, 50.0, 36.0, 25.0), 12.0);
+        let right = at_shift(2, ellipse(170.0, 52.0, 36.0, 25.0), 18.0);
+        let (own, other, pixels) = scene(&[left, right], 1.0, 0);
+        let whole = ParallaxRule {
+            min_depth_halfwidths: f64::INFINITY,
+            ..rule()
+        };
+        let mut layers = layers(pixels, &partner(&own, &other, 1), 25, whole);
+        assert_eq!(layers.len(), 1);
+        let layer = layers.remove(0);
+        assert!(layer.shifts.is_none());
+        let (left, right): (Vec<_>, Vec<_>) = layer.pixels.iter().partition(|p| p.0 < 140);
+        let lookup = ShiftLookup::new(&layer.pixels, layer.pixel_shifts);
+        let within = |range: Option<[f32; 2]>, shift: f32| {
+            range.is_some_and(|[low, high]| {
+                (low - shift).abs() <= 1.0 && (high - shift).abs() <= 1.0
+            })
+        };
+        assert!(
+            within(lookup.range_of(&left), 12.0),
+            "{:?}",
+            lookup.range_of(&left)
+        );
+        assert!(
+            within(lookup.range_of(&right), 18.0),
+            "{:?}",
+            lookup.range_of(&right)
+        );
+        assert_eq!(lookup.range_of(&[(0, 0)]), None, "a pixel outside the blob");
     }
 
     /// A lump on top of a wide rock, 0.75 m behind its face at 9.8 m: a step, but less than

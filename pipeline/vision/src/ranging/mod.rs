@@ -186,7 +186,14 @@ pub fn observe(
             let right_detection = matches[i].zip(right).map(|(j, r)| &r[j]);
             let stereo = right_detection
                 .map(|r| stereo_cue(d, r, calib, model))
-                .or_else(|| parallax_cue(d, calib, model, reach_width));
+                // Pixel shifts stand in for a partner only where none can be had: a separated
+                // part, or a piece touching another. A whole detection whose pairing was
+                // ambiguous keeps no cue, as `match_stereo` chose (given one, marsyard s19 and
+                // stress s10 had 5 and 3 unsound relations, docs/RUN.md stop 66).
+                .or_else(|| {
+                    parallax_cue(d, calib, model, reach_width)
+                        .filter(|_| piece || d.separation != Separation::Whole)
+                });
             let (fused, conflict) = fuse([ground, stereo, None]);
             // The ray is where the detection itself was seen; a piece's bearing takes in the
             // columns it may reach over.
