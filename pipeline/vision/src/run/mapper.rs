@@ -567,6 +567,7 @@ impl<C: Calculus> Mapper<C> {
             if d.separation != Separation::Whole
                 || d.contact_slack_rows > 0.0
                 || ranged[i].piece
+                || ranged[i].cut_off
                 || selection::doubted(d)
             {
                 continue;

@@ -146,12 +146,13 @@ pub(crate) fn station_evidence(
 }
 
 /// The physical width a detection implies for its rock (`ranging::width_evidence`), unless it
-/// is a part of a blob separated by parallax, a piece touching another, or doubted: a false
+/// is a part of a blob separated by parallax, a piece touching another, cut off by the image's
+/// bottom edge (its visible width is not its rock's), or doubted: a false
 /// cut of one large rock (its sides read farther than its middle) leaves a part narrower than
 /// the rock, which would bound the landmark's width too low and put the size cue's ranges too
 /// far.
 fn width_of(d: &Detection, ranged: &Ranged, model: &SensorModel) -> Option<RangeInterval> {
-    (d.separation == Separation::Whole && !ranged.piece && !doubted(d))
+    (d.separation == Separation::Whole && !ranged.piece && !ranged.cut_off && !doubted(d))
         .then(|| ranging::width_evidence(ranged, model))
         .flatten()
 }
@@ -282,6 +283,7 @@ mod tests {
             fused: RangeInterval::new(4.0, 5.0),
             conflict: false,
             piece: false,
+            cut_off: false,
         }
     }
 
