@@ -230,6 +230,7 @@ fn select_from_panorama(
         &detections.primary,
         detections.right.as_deref(),
         PrimaryEye::Left,
+        detections.channels,
         terrain.calib,
         &settings.sensor,
     );

@@ -138,6 +138,7 @@ impl<C: Calculus> KnownMap<C> {
             &station.primary,
             station.right.as_deref(),
             station.eye,
+            station.channels,
             calib,
             sensor,
         );
@@ -173,7 +174,10 @@ impl<C: Calculus> KnownMap<C> {
         // Measured as mapping measures a station (`run::selection::view_of`): the range
         // ratios bounded where ground and stereo agree.
         let seen = StationView::new(
-            indices.iter().map(|&i| ranged[i].bearing).collect(),
+            indices
+                .iter()
+                .map(|&i| ranged[i].measured_bearing())
+                .collect(),
             RangeOrder::from_pairs(indices.len(), &order.restricted(&indices))
                 .expect("a sub-order of a strict order"),
         )

@@ -218,6 +218,7 @@ impl<C: Calculus> Mapper<C> {
             &station.primary,
             station.right.as_deref(),
             station.eye,
+            station.channels,
             &self.calib,
             &self.sensor,
         );
@@ -1067,7 +1068,7 @@ fn detection_record(d: &Detection, r: &Ranged) -> DetectionRecord {
         flat: d.flat,
         stereo_column: r.stereo_column,
         bearing: r.bearing.angle,
-        bearing_uncertainty: r.bearing.uncertainty,
+        bearing_uncertainty: r.measured_bearing().uncertainty,
         range: RangeRecord {
             ground: r.ground.map(|g| g.as_array()),
             stereo: r.stereo.map(|s| s.as_array()),

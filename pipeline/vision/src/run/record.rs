@@ -59,7 +59,8 @@ pub struct DetectionRecord {
     pub stereo_column: Option<f64>,
     /// Bearing from the station centre, radians counter-clockwise from the calibration's zero.
     pub bearing: f64,
-    /// Half-width of the bearing interval, radians.
+    /// Half-width of the bearing interval the map measures with, radians
+    /// (`ranging::Ranged::measured_bearing`).
     pub bearing_uncertainty: f64,
     /// Range intervals (metres) from each cue that applied, and their fusion.
     pub range: RangeRecord,

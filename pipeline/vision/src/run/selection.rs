@@ -49,7 +49,7 @@ pub(super) fn exclusion(
         Some(Exclusion::Sliver)
     } else if stacked(d) {
         Some(Exclusion::Stacked)
-    } else if ranged[i].bearing.uncertainty >= MAX_BEARING_UNCERTAINTY {
+    } else if ranged[i].measured_bearing().uncertainty >= MAX_BEARING_UNCERTAINTY {
         Some(Exclusion::WideBearing)
     } else {
         None
@@ -222,7 +222,7 @@ pub(crate) fn placement(bearing: f64, uncertainty: f64, [low, high]: [f64; 2]) -
 /// range intervals that bound their ratios ([`ranging::ratio_bounds`]).
 pub(super) fn view_of(ranged: &[Ranged], usable: &[usize]) -> StationView {
     let chosen: Vec<Ranged> = usable.iter().map(|&i| ranged[i]).collect();
-    let bearings: Vec<Bearing> = chosen.iter().map(|r| r.bearing).collect();
+    let bearings: Vec<Bearing> = chosen.iter().map(Ranged::measured_bearing).collect();
     let order: RangeOrder = ranging::range_order(&chosen);
     let ranges = chosen.iter().map(ranging::ratio_bounds).collect();
     StationView::new(bearings, order)
@@ -284,6 +284,7 @@ mod tests {
             conflict: false,
             piece: false,
             cut_off: false,
+            lit_face: 0.0,
         }
     }
 
