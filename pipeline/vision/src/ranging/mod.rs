@@ -531,7 +531,7 @@ fn columns_overlap(a: [u32; 4], b: [u32; 4], slack: u32, width: u32) -> bool {
 /// each eye sees the part above the edge, which may lie on any side of its reference point, so
 /// that point may be nearer or farther by `reach_per_width` of its width (`angular_width` ·
 /// range). On six colour marsyard renderings 7 of 115 such rocks fused lay outside their
-/// stereo-and-size interval, by up to 16 %, and 1 of 6 316 other sightings (docs/RUN.md, stop 70).
+/// stereo-and-size interval, by up to 21 %, and 1 of 6 316 other sightings (docs/RUN.md, stop 70).
 /// `None` when that reach spans every range.
 fn stereo_cue(
     d: &Detection,
