@@ -484,32 +484,65 @@ fn placed_pairs(
 
 /// The motion refitted on all `inliers`, and the correspondences it makes unambiguous: every
 /// other landmark of the frame, and every other detection, lies clearly farther (distances for
-/// the placements' shapes: a [`Separation`]'s).
+/// the placements' shapes: a [`Separation`]'s). Decided jointly: a detection near the landmark
+/// that an unambiguous pair of its own explains ([`explained`]) is no rival (two touching rocks
+/// with a landmark each, whose placements reach over each other).
 fn unambiguous(
     current: &[Option<Placed>],
     frame: &Frame,
     inliers: &[(usize, usize)],
 ) -> (Motion, Vec<(usize, LandmarkId)>) {
     let motion = Motion::fit(&placed_pairs(current, frame, inliers));
+    let alone: Vec<(usize, usize)> = inliers
+        .iter()
+        .copied()
+        .filter(|&(i, j)| unambiguous_pair(&motion, current, frame, i, j, |_| true))
+        .collect();
     let pairs = inliers
         .iter()
         .copied()
-        .filter(|&(i, j)| unambiguous_pair(&motion, current, frame, i, j))
+        .filter(|&(i, j)| {
+            alone.contains(&(i, j))
+                || unambiguous_pair(&motion, current, frame, i, j, |k| {
+                    !explained(&motion, current, frame, &alone, k, j)
+                })
+        })
         .map(|(i, j)| (i, frame.landmarks[j].0))
         .collect();
     (motion, pairs)
 }
 
+/// Whether detection `k` is explained away from landmark `j` of the frame: one of `pairs`
+/// (detection, index into the frame's landmarks) pairs it with another landmark, which lies
+/// nearer it than `j` does.
+fn explained(
+    motion: &Motion,
+    current: &[Option<Placed>],
+    frame: &Frame,
+    pairs: &[(usize, usize)],
+    k: usize,
+    j: usize,
+) -> bool {
+    let Some(p) = current[k] else {
+        return false;
+    };
+    let distance = |m: usize| motion.separation(&p, &frame.landmarks[m].1).distance;
+    pairs
+        .iter()
+        .any(|&(i, m)| i == k && m != j && distance(m) < distance(j))
+}
+
 /// Whether landmark `j` of the frame is detection `i`'s unambiguous partner under `motion`:
 /// the detection is placed no looser than registration pairs ([`LONG_ANCHOR_RADIUS_M`]), the
 /// landmark lies within the pair's separation, every other landmark clearly farther from the
-/// detection and every other placed detection clearly farther from the landmark.
+/// detection and every other placed detection that `rivals` clearly farther from the landmark.
 fn unambiguous_pair(
     motion: &Motion,
     current: &[Option<Placed>],
     frame: &Frame,
     i: usize,
     j: usize,
+    rivals: impl Fn(usize) -> bool,
 ) -> bool {
     let Some(p) = current[i] else {
         return false;
@@ -521,7 +554,7 @@ fn unambiguous_pair(
         && p.reach() <= LONG_ANCHOR_RADIUS_M
         && (0..frame.landmarks.len())
             .all(|k| k == j || motion.separation(&p, &frame.landmarks[k].1).distance > near)
-        && others_farther(motion, current, i, &q, near, |_| true)
+        && others_farther(motion, current, i, &q, near, rivals)
 }
 
 /// Whether every placed detection of `placed` but `i` that `counts` lies farther than `near`
@@ -545,7 +578,7 @@ impl Registration {
     /// unambiguous partner: the landmark, `alike` the observer and not paired already, lies
     /// within the pair's separation, every other landmark of the frame clearly farther from
     /// the observer, and every other placed detection (`placed`, observers included) clearly
-    /// farther from the landmark. An observer neither steers the motion nor changes what the
+    /// farther from the landmark, but those the fit's pairs explain ([`explained`]). An observer neither steers the motion nor changes what the
     /// fit's significance is judged on (`sparse-large` seed 3 half: with the doubted
     /// detections in the fit, station 58 registered against no frame, and the 25 stations
     /// after it fused nothing).
@@ -557,6 +590,12 @@ impl Registration {
         alike: &dyn Fn(usize, LandmarkId) -> bool,
     ) {
         let motion = self.motion();
+        // The fit's pairs, by index into the frame's landmarks.
+        let paired: Vec<(usize, usize)> = self
+            .pairs
+            .iter()
+            .filter_map(|&(i, l)| Some((i, frame.landmarks.iter().position(|m| m.0 == l)?)))
+            .collect();
         let mut added = Vec::new();
         for &i in observers {
             let Some(p) = placed[i] else {
@@ -569,8 +608,11 @@ impl Registration {
                 .map(|(j, (_, q))| (j, motion.separation(&p, q).distance))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
                 .map(|(j, _)| j);
-            let Some(j) = nearest.filter(|&j| unambiguous_pair(&motion, placed, frame, i, j))
-            else {
+            let Some(j) = nearest.filter(|&j| {
+                unambiguous_pair(&motion, placed, frame, i, j, |k| {
+                    !explained(&motion, placed, frame, &paired, k, j)
+                })
+            }) else {
                 continue;
             };
             let l = frame.landmarks[j].0;
@@ -1447,6 +1489,37 @@ pub(super) mod tests {
         assert_eq!(kept([3.2, 1.1], &|_, _| true), all[1..]);
         assert_eq!(kept([3.2, 1.1], &|i, _| i != 4), all);
         assert_eq!(kept([4.5, 2.5], &|_, _| true), all);
+    }
+
+    /// Two touching rocks, each with its landmark (6 and 7, 0.9 m apart): the piece of rock 7
+    /// is placed along its neighbour's columns too, so it lies as near landmark 6 as rock 6's
+    /// own detection does. Decided alone, rock 6's pair is ambiguous; rock 7's detection is
+    /// explained by its own unambiguous pair with landmark 7, so both pairs stand. Unpaired,
+    /// nothing explains it, and rock 6's pair stays ambiguous.
+    #[test]
+    fn a_neighbour_paired_with_its_own_landmark_is_no_rival() {
+        let mut points: Vec<Placed> = FIELD.iter().map(|&p| Placed::disc(p, 0.3)).collect();
+        points.push(Placed::disc([2.15, 4.0], 0.1));
+        points.push(Placed::along([2.9, 4.0], 0.0, 0.9, 0.1));
+        let current: Vec<Option<Placed>> = points.into_iter().map(Some).collect();
+        let mut frame = field_frame();
+        frame.landmarks.push((6, Placed::disc([2.0, 4.0], 0.1)));
+        frame.landmarks.push((7, Placed::disc([2.9, 4.0], 0.1)));
+        let inliers: Vec<(usize, usize)> = (0..8).map(|k| (k, k)).collect();
+        let motion = Motion::identity();
+        assert!(!unambiguous_pair(&motion, &current, &frame, 6, 6, |_| true));
+        assert!(unambiguous_pair(&motion, &current, &frame, 7, 7, |_| true));
+        let pairs = unambiguous(&current, &frame, &inliers).1;
+        assert!(pairs.contains(&(6, 6)) && pairs.contains(&(7, 7)));
+        let unexplained = |k| !explained(&motion, &current, &frame, &[], k, 6);
+        assert!(!unambiguous_pair(
+            &motion,
+            &current,
+            &frame,
+            6,
+            6,
+            unexplained
+        ));
     }
 
     /// By luminance (`fragmented`), an unmapped rock within the paired landmark's own
