@@ -578,10 +578,10 @@ impl Registration {
     /// unambiguous partner: the landmark, `alike` the observer and not paired already, lies
     /// within the pair's separation, every other landmark of the frame clearly farther from
     /// the observer, and every other placed detection (`placed`, observers included) clearly
-    /// farther from the landmark, but those the fit's pairs explain ([`explained`]). An observer neither steers the motion nor changes what the
-    /// fit's significance is judged on (`sparse-large` seed 3 half: with the doubted
-    /// detections in the fit, station 58 registered against no frame, and the 25 stations
-    /// after it fused nothing).
+    /// farther from the landmark, but those the fit's pairs explain ([`explained`]). An
+    /// observer neither steers the motion nor changes what the fit's significance is judged on
+    /// (`sparse-large` seed 3 half: with the doubted detections in the fit, station 58
+    /// registered against no frame, and the 25 stations after it fused nothing).
     pub fn pair_observers(
         &mut self,
         frame: &Frame,
