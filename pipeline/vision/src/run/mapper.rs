@@ -1242,10 +1242,6 @@ mod tests {
         assert_eq!(sighted.bearings.len(), 2);
     }
 
-    /// The test drive fused through a mapper with rock `B` taken for landmark `A` at station
-    /// 12, as association would if nothing checked it, the audit run after every station.
-    /// Later stations take `B` for whatever landmark its last sighting now has, as tracking
-    /// would.
     /// The test drive's stations 0–2 fused with every rock as its own landmark, but rock
     /// `R` at station 2 held back with landmarks `R` and 3 for candidates; returns the held
     /// observation's placement.
