@@ -114,6 +114,17 @@ fn maps_the_demo_dataset_soundly() {
     );
     assert_eq!(score(&["map", "run", "unsound_relations"]), 0.0, "{eval}");
     assert_eq!(score(&["map", "exact", "unsound_relations"]), 0.0, "{eval}");
+    // True bearings with the run's own range evidence, which holds the truth here.
+    assert_eq!(
+        score(&["map", "true_bearings", "unsound_relations"]),
+        0.0,
+        "{eval}"
+    );
+    assert_eq!(
+        score(&["map", "rng_true_bearings", "recall"]),
+        1.0,
+        "{eval}"
+    );
     assert!(
         score(&["bearing_used", "within_interval"]) >= 0.95,
         "{eval}"

@@ -240,9 +240,13 @@ pub fn print_report(e: &Evaluation) {
         "  reached the map: {:.1} % of detections matched to rocks; {} of the {} rocks detected at 3 or more stations have a landmark ({:.1} %)",
         100.0 * a.fused_fraction, a.rocks_seen_thrice_mapped, a.rocks_seen_thrice, 100.0 * a.mapped_fraction
     );
-    for (name, m) in [("run", &e.map.run), ("exact", &e.map.exact)] {
+    for (name, m) in [
+        ("run", &e.map.run),
+        ("exact", &e.map.exact),
+        ("true bearings", &e.map.true_bearings),
+    ] {
         println!(
-            "  map ({name:<5}): {} landmarks, {} triples, {:.1} % open ({:.1} % among landmarks of one rock each), {:.1} % of incorrect states removed ({:.1} % among landmarks of one rock each), {:.1} % fully constrained, {} unsound relations",
+            "  map ({name}): {} landmarks, {} triples, {:.1} % open ({:.1} % among landmarks of one rock each), {:.1} % of incorrect states removed ({:.1} % among landmarks of one rock each), {:.1} % fully constrained, {} unsound relations",
             m.landmarks, m.triples, m.open_pct, m.open_pct_defined, m.removed_incorrect_pct, m.removed_incorrect_pct_defined, m.fully_constrained_pct, m.unsound_relations
         );
         if !m.unsound_landmarks.is_empty() {
@@ -271,10 +275,14 @@ pub fn print_report(e: &Evaluation) {
             pct(c.conditioned_truth_most_likely)
         );
     }
-    for (name, rng) in [("run", &e.map.rng), ("exact", &e.map.rng_exact)] {
+    for (name, rng) in [
+        ("run", &e.map.rng),
+        ("exact", &e.map.rng_exact),
+        ("true bearings", &e.map.rng_true_bearings),
+    ] {
         if let Some(rng) = rng {
             println!(
-                "  RNG ({name:<5}): precision {:.2}, recall {:.2}, {} true edges pruned, over the {} one-rock landmarks",
+                "  RNG ({name}): precision {:.2}, recall {:.2}, {} true edges pruned, over the {} one-rock landmarks",
                 rng.precision, rng.recall, rng.true_edges_pruned, rng.landmarks
             );
             let cuts: Vec<String> = rng

@@ -1,5 +1,6 @@
-//! Scoring the map: the run's map and one built from exact measurements of the same landmarks
-//! at the same stations, against the classification of the true rock positions.
+//! Scoring the map: the run's map, one built from exact measurements of the same landmarks at
+//! the same stations, and one from true bearings with the run's own range evidence, against
+//! the classification of the true rock positions.
 
 use super::association::LandmarkRocks;
 use super::detection::ratio;
@@ -43,7 +44,8 @@ pub(super) fn score(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> Map
     let defined_truth = |a: LandmarkId, b: LandmarkId, c: LandmarkId| {
         Edc::classify(position(a)?, position(b)?, position(c)?)
     };
-    let exact = exact_map(run, truth, rocks);
+    let exact = reference_map(run, truth, rocks, Reference::Exact);
+    let true_bearings = reference_map(run, truth, rocks, Reference::TrueBearings);
     let rng = |map: &Hypergraph<Edc>| {
         let map = map.restricted(defined);
         if map.len() < 3 {
@@ -84,25 +86,48 @@ pub(super) fn score(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> Map
     MapScore {
         run: map_score(run.map, &majority_truth, &defined),
         exact: map_score(&exact, &defined_truth, &defined),
+        true_bearings: map_score(&true_bearings, &defined_truth, &defined),
         rng: rng(run.map),
         rng_exact: rng(&exact),
+        rng_true_bearings: rng(&true_bearings),
     }
 }
 
-/// The map from exact measurements of the same landmarks at the same stations: true bearings
-/// from the station centre and the true total range order.
-fn exact_map(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> Hypergraph<Edc> {
+/// What a reference map measures the run's sightings with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Reference {
+    /// True bearings from the station centre and the true total range order: the paper's
+    /// exact observations (000 §IV).
+    Exact,
+    /// True bearings with the run's own range evidence: its asserted "nearer than" pairs and
+    /// its range-ratio bounds. Between the run's map and this one lies what the bearings'
+    /// intervals cost; between this one and the exact map, what the range evidence leaves
+    /// out.
+    TrueBearings,
+}
+
+/// The map from `reference` measurements of the same landmarks at the same stations.
+fn reference_map(
+    run: &RunFiles,
+    truth: &Truth,
+    rocks: &LandmarkRocks,
+    reference: Reference,
+) -> Hypergraph<Edc> {
     let mut map = Hypergraph::<Edc>::new();
     for (record, image) in eval_records(run.records, truth) {
         let station = &truth.stations[image.station];
-        let mut ids: Vec<LandmarkId> = run
+        // Each one-rock landmark the station fused, with the detection it fused.
+        let mut sighted: Vec<(LandmarkId, usize)> = run
             .landmarks
             .iter()
-            .filter(|l| l.sightings.iter().any(|s| s.0 == record.index))
-            .map(|l| l.landmark)
-            .filter(|&l| rocks.defined(l).is_some())
+            .filter(|l| rocks.defined(l.landmark).is_some())
+            .filter_map(|l| {
+                let s = l.sightings.iter().find(|s| s.0 == record.index)?;
+                Some((l.landmark, s.1))
+            })
             .collect();
-        ids.sort_unstable();
+        sighted.sort_unstable();
+        let ids: Vec<LandmarkId> = sighted.iter().map(|s| s.0).collect();
         if ids.len() < 3 {
             continue;
         }
@@ -117,12 +142,34 @@ fn exact_map(run: &RunFiles, truth: &Truth, rocks: &LandmarkRocks) -> Hypergraph
                 )
             })
             .collect();
-        let mut nearest_first: Vec<usize> = (0..ids.len()).collect();
-        nearest_first.sort_by(|&a, &b| polar[a].1.total_cmp(&polar[b].1));
-        let order = RangeOrder::total(&nearest_first).expect("a permutation");
-        let Ok(panorama) =
-            StationView::new(polar.iter().map(|p| Bearing::exact(p.0)).collect(), order)
-        else {
+        let bearings = polar.iter().map(|p| Bearing::exact(p.0)).collect();
+        let panorama = match reference {
+            Reference::Exact => {
+                let mut nearest_first: Vec<usize> = (0..ids.len()).collect();
+                nearest_first.sort_by(|&a, &b| polar[a].1.total_cmp(&polar[b].1));
+                let order = RangeOrder::total(&nearest_first).expect("a permutation");
+                StationView::new(bearings, order)
+            }
+            Reference::TrueBearings => {
+                let position = |detection: usize| sighted.iter().position(|s| s.1 == detection);
+                let nearer: Vec<(usize, usize)> = record
+                    .order
+                    .iter()
+                    .filter_map(|&(a, b)| Some((position(a)?, position(b)?)))
+                    .collect();
+                let ranges = sighted
+                    .iter()
+                    .map(|s| record.detections.get(s.1).map(|d| d.range.ratio_bounds()))
+                    .collect::<Option<Vec<_>>>();
+                let (Ok(order), Some(ranges)) =
+                    (RangeOrder::from_pairs(ids.len(), &nearer), ranges)
+                else {
+                    continue;
+                };
+                StationView::new(bearings, order).and_then(|view| view.with_ranges(ranges))
+            }
+        };
+        let Ok(panorama) = panorama else {
             continue;
         };
         let batch = map.observations(&panorama, &Sighting::all(&ids));

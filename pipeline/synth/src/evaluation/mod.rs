@@ -152,11 +152,16 @@ pub struct MixedLandmark {
 pub struct MapScore {
     pub run: MapMetricsScore,
     pub exact: MapMetricsScore,
-    /// The RNG estimate (000 §VII-A) of the run's map and of the exact map, each restricted to
-    /// the landmarks that stand for one rock each, against the true RNG of those rocks. `None`
-    /// with fewer than three such landmarks.
+    /// The map of the run's sightings measured with true bearings and the run's own range
+    /// evidence (its "nearer than" pairs and range-ratio bounds): the run's map differs from
+    /// it only by the bearings' intervals.
+    pub true_bearings: MapMetricsScore,
+    /// The RNG estimate (000 §VII-A) of the run's map, of the exact map and of the
+    /// true-bearings map, each restricted to the landmarks that stand for one rock each,
+    /// against the true RNG of those rocks. `None` with fewer than three such landmarks.
     pub rng: Option<RngScore>,
     pub rng_exact: Option<RngScore>,
+    pub rng_true_bearings: Option<RngScore>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]

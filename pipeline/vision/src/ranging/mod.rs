@@ -297,7 +297,16 @@ pub fn width_evidence(ranged: &Ranged, model: &SensorModel) -> Option<RangeInter
 /// arrangement (7 relations on two sets); by the size cue too, a rock cut off by the image's
 /// bottom edge was put 25 % too far (6 relations on marsyard seed 11).
 pub fn ratio_bounds(ranged: &Ranged) -> RangeBounds {
-    match (ranged.ground, ranged.stereo) {
+    corroborated_bounds(ranged.ground, ranged.stereo)
+}
+
+/// [`ratio_bounds`] from the flat-ground and stereo cues' intervals, as a run's records keep
+/// them (`run::RangeRecord::ratio_bounds`).
+pub fn corroborated_bounds(
+    ground: Option<RangeInterval>,
+    stereo: Option<RangeInterval>,
+) -> RangeBounds {
+    match (ground, stereo) {
         (Some(ground), Some(stereo)) => {
             ground
                 .intersection(stereo)

@@ -3,7 +3,9 @@
 //! meanings are documented in `docs/RUN.md`.
 
 use crate::association::Unfounded;
+use crate::ranging::RangeInterval;
 use qrm_core::map::LandmarkId;
+use qrm_core::measurement::RangeBounds;
 use serde::{Deserialize, Serialize};
 
 /// Everything the run learned from one station's panorama(s).
@@ -81,6 +83,15 @@ pub struct RangeRecord {
     pub fused: [f64; 2],
     /// The cues' intervals did not overlap; `fused` is then their hull.
     pub conflict: bool,
+}
+
+impl RangeRecord {
+    /// The bounds the map measured the detection's range ratios with
+    /// ([`crate::ranging::ratio_bounds`]).
+    pub fn ratio_bounds(&self) -> RangeBounds {
+        let interval = |b: [f64; 2]| RangeInterval::new(b[0], b[1]);
+        crate::ranging::corroborated_bounds(self.ground.map(interval), self.stereo.map(interval))
+    }
 }
 
 /// What data association decided for one detection (000 §VI-C).
@@ -291,5 +302,30 @@ mod tests {
         let text = serde_json::to_string(&record).unwrap();
         assert!(text.contains("null"), "{text}");
         assert_eq!(serde_json::from_str::<RangeRecord>(&text).unwrap(), record);
+    }
+
+    /// A record bounds its ratios as the run measured them: by the two cues where both range
+    /// the detection and agree, not by one cue alone, nor by the size cue.
+    #[test]
+    fn a_record_bounds_range_ratios_only_where_ground_and_stereo_agree() {
+        let record = |ground, stereo| RangeRecord {
+            ground,
+            stereo,
+            size: Some([4.5, 5.5]),
+            fused: [0.0, f64::INFINITY],
+            conflict: false,
+        };
+        let both = record(Some([4.0, 6.0]), Some([5.0, 7.0])).ratio_bounds();
+        assert_eq!((both.low, both.high), (5.0, 6.0));
+        for (ground, stereo) in [
+            (Some([4.0, 6.0]), None),
+            (None, Some([5.0, 7.0])),
+            (Some([4.0, 4.5]), Some([5.0, 7.0])),
+        ] {
+            assert_eq!(
+                record(ground, stereo).ratio_bounds(),
+                RangeBounds::UNBOUNDED
+            );
+        }
     }
 }
