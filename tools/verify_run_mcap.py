@@ -30,8 +30,9 @@ EXPECTED = {
         {"ranges": {"detection", "ground", "stereo", "size", "fused", "conflict"}},
     ),
     "/association": (
-        {"index", "station", "associations"},
-        {"associations": {"detection", "decision"}},
+        {"index", "station", "associations", "registrations"},
+        {"associations": {"detection", "decision"},
+         "registrations": {"frame", "pairs", "nfa", "believed"}},
     ),
     "/measurements": (
         {"index", "station", "files", "landmarks", "triples", "relations_tightened",
@@ -116,6 +117,10 @@ def verify(path):
         last = by_topic.get("/map_metrics", {}).get(stations - 1, {})
         rejected = sum(1 for m in by_topic.get("/measurements", {}).values() if m.get("contradiction"))
         summary.append(f"  detections {detections} ({', '.join(f'{k} {v}' for k, v in sorted(decisions.items()))})")
+        registrations = [r for m in by_topic.get("/association", {}).values()
+                         for r in m.get("registrations", [])]
+        believed = sum(1 for r in registrations if r.get("believed"))
+        summary.append(f"  registrations {len(registrations)} ({believed} believed)")
         summary.append(f"  stations rejected by the map: {rejected}")
         summary.append(f"  final map: {last.get('landmarks')} landmarks, {last.get('triples')} triples, "
                        f"open {last.get('open_fraction')}, fully constrained "
@@ -142,6 +147,18 @@ def check_keys(topic, value, where):
                 problems.append(f"{where}: associations[{i}] {decision} without landmark")
             elif decision == "held_back" and "candidates" not in a:
                 problems.append(f"{where}: associations[{i}] held_back without candidates")
+        detections = len(value.get("associations") or [])
+        for i, r in enumerate(value.get("registrations") or []):
+            frame = r.get("frame")
+            if frame is not None and not (isinstance(frame, int) and 0 <= frame):
+                problems.append(f"{where}: registrations[{i}] frame {frame!r}")
+            if frame is not None and isinstance(frame, int) and frame == value.get("index"):
+                problems.append(f"{where}: registrations[{i}] registers the station against itself")
+            if not isinstance(r.get("believed"), bool):
+                problems.append(f"{where}: registrations[{i}] believed is not a boolean")
+            for pair in r.get("pairs") or []:
+                if not (isinstance(pair, list) and len(pair) == 2 and 0 <= pair[0] < detections):
+                    problems.append(f"{where}: registrations[{i}] pair {pair!r} names no detection")
     if topic == "/map_metrics" and STAGES - set(value.get("seconds") or {}):
         problems.append(f"{where}: seconds lacks {sorted(STAGES - set(value.get('seconds') or {}))}")
     return problems

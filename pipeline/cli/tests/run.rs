@@ -132,6 +132,7 @@ fn maps_the_demo_dataset_soundly() {
     assert!(score(&["association", "accuracy"]) >= 0.9, "{eval}");
     assert!(score(&["detection", "recall"]) >= 0.7, "{eval}");
     assert_counts_agree(&out);
+    assert_matches_come_from_believed_registrations(&json(&out.join("stations.json")));
     assert!(
         eval["detection"]["precision"].as_f64().unwrap() >= 0.9,
         "{eval}"
@@ -149,6 +150,45 @@ fn maps_the_demo_dataset_soundly() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(json(&again.join("eval.json")), eval);
+}
+
+/// Every station's matches are pairs of a registration it believed (000 §VI-C: only a
+/// believed registration's pairs anchor), every believed one has an NFA below 1, and most
+/// stations after the first registered against an earlier frame.
+fn assert_matches_come_from_believed_registrations(stations: &serde_json::Value) {
+    let stations = stations.as_array().unwrap();
+    let mut registered = 0;
+    for station in &stations[1..] {
+        let registrations = station["registrations"]
+            .as_array()
+            .cloned()
+            .unwrap_or_default();
+        let believed: Vec<&serde_json::Value> = registrations
+            .iter()
+            .filter(|r| r["believed"] == true)
+            .collect();
+        registered += usize::from(!believed.is_empty());
+        for r in &believed {
+            assert!(r["nfa"].as_f64().unwrap() < 1.0, "{r}");
+        }
+        for (detection, d) in station["detections"].as_array().unwrap().iter().enumerate() {
+            if d["association"]["decision"] == "matched" {
+                let pair = serde_json::json!([detection, d["association"]["landmark"]]);
+                assert!(
+                    believed
+                        .iter()
+                        .any(|r| r["pairs"].as_array().unwrap().contains(&pair)),
+                    "station {}: match {pair} in no believed registration",
+                    station["index"]
+                );
+            }
+        }
+    }
+    assert!(
+        2 * registered >= stations.len(),
+        "{registered} of {}",
+        stations.len()
+    );
 }
 
 /// `--mode probabilistic` writes 002's beliefs beside the same map of sets, keyed by its

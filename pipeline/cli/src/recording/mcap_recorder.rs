@@ -11,7 +11,9 @@ use serde::Serialize;
 
 use super::{Problem, Recorder, RecordingError, RngDrawing};
 use qrm_atomic_file::Temporary;
-use qrm_vision::run::{Association, LateSighting, MetricsRecord, StageSeconds, StationRecord};
+use qrm_vision::run::{
+    Association, LateSighting, MetricsRecord, RegistrationRecord, StageSeconds, StationRecord,
+};
 
 /// The channels, in the order their ids are kept.
 #[derive(Clone, Copy)]
@@ -221,6 +223,7 @@ impl McapRecorder {
                         association: &d.association,
                     })
                     .collect(),
+                registrations: &r.registrations,
             },
         )?;
         let f = &r.fusion;
@@ -362,6 +365,7 @@ struct AssociationMessage<'a> {
     index: usize,
     station: &'a str,
     associations: Vec<Decision<'a>>,
+    registrations: &'a [RegistrationRecord],
 }
 
 #[derive(Serialize)]

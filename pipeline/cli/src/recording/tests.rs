@@ -13,7 +13,7 @@ use super::*;
 use qrm_vision::detection::Channels;
 use qrm_vision::run::{
     Association, DetectionRecord, Exclusion, FusionRecord, LateSighting, MetricsRecord,
-    RangeRecord, StageSeconds,
+    RangeRecord, RegistrationRecord, StageSeconds,
 };
 
 const STATIONS: usize = 16;
@@ -83,6 +83,21 @@ fn station(index: usize) -> StationRecord {
         channels: Channels::Colour,
         detections,
         order: vec![(0, 1), (0, 2)],
+        // The sketch registered and was believed; station 0's frame, from station 2 on, fitted
+        // a motion chance explains.
+        registrations: std::iter::once(RegistrationRecord {
+            frame: None,
+            pairs: vec![(0, 7)],
+            nfa: Some(1e-4),
+            believed: true,
+        })
+        .chain((index >= 2).then_some(RegistrationRecord {
+            frame: Some(0),
+            pairs: vec![(0, 7), (1, 4)],
+            nfa: None,
+            believed: false,
+        }))
+        .collect(),
         fusion: FusionRecord {
             usable: count,
             landmarks: count,
@@ -327,6 +342,18 @@ fn mcap_has_every_channel_once_per_station_matching_its_schema() {
                 assert_eq!(decisions[0]["landmark"], 7);
                 if expected.detections.len() > 2 {
                     assert_eq!(decisions[2]["candidates"], serde_json::json!([3, 5]));
+                }
+                let registrations = value["registrations"].as_array().unwrap();
+                assert_eq!(registrations.len(), expected.registrations.len());
+                assert_eq!(
+                    registrations[0],
+                    serde_json::json!({"frame": null, "pairs": [[0, 7]], "nfa": 1e-4, "believed": true})
+                );
+                if index >= 2 {
+                    // An unbounded NFA is written as null, as JSON has no infinity.
+                    assert_eq!(registrations[1]["frame"], 0);
+                    assert_eq!(registrations[1]["nfa"], Value::Null);
+                    assert_eq!(registrations[1]["believed"], false);
                 }
             }
             "/measurements" => {

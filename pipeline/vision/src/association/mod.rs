@@ -215,6 +215,24 @@ pub enum Decision {
 pub struct StationAssociation {
     pub decisions: Vec<Decision>,
     pub recognitions: Vec<Recognition>,
+    /// Every frame the station's detections registered against, believed or not.
+    pub registrations: Vec<FrameRegistration>,
+}
+
+/// One registration of a station's detections against a frame, as association judged it: a
+/// run's record of why its detections were anchored or held back (docs/RUN.md, "stations.json").
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameRegistration {
+    /// Index into the frames association was given.
+    pub frame: usize,
+    /// `(detection, landmark)`, detections by index into the station's evidence: the pairs
+    /// anchors were drawn from when believed, else the fit's own.
+    pub pairs: Vec<(usize, LandmarkId)>,
+    /// The fit's number of false alarms ([`Registration::nfa`]).
+    pub nfa: f64,
+    /// Whether its pairs could anchor: it kept [`MIN_INLIERS`] pairs and chance does not
+    /// explain it ([`believed`]).
+    pub believed: bool,
 }
 
 /// Why a detection that matched no landmark founds none of its own ([`unfounded`]).
@@ -293,6 +311,7 @@ pub fn associate<C: Calculus>(
         return StationAssociation {
             decisions: evidence.iter().map(founded).collect(),
             recognitions: Vec::new(),
+            registrations: Vec::new(),
         };
     }
     let candidates: Vec<Vec<(LandmarkId, f64)>> = evidence
@@ -330,6 +349,10 @@ pub fn associate<C: Calculus>(
         &seen,
         lately,
     );
+    let found: Vec<(usize, Registration)> = registrations
+        .iter()
+        .map(|(frame, registration)| (frame_index(frames, frame), registration.clone()))
+        .collect();
     // The station's usable detections' rays lead `seen`.
     let rays = &seen[..n];
     let alike = |i: usize, l: LandmarkId| looks_alike(&candidates, i, l);
@@ -401,10 +424,34 @@ pub fn associate<C: Calculus>(
             }
         })
         .collect();
+    let registrations = found
+        .into_iter()
+        .map(|(frame, fit)| {
+            let kept = registrations
+                .iter()
+                .find(|(f, _)| frame_index(frames, f) == frame);
+            let (registration, believed) = kept.map_or((fit, false), |(_, r)| (r.clone(), true));
+            FrameRegistration {
+                frame,
+                pairs: registration.pairs,
+                nfa: registration.nfa,
+                believed,
+            }
+        })
+        .collect();
     StationAssociation {
         decisions,
         recognitions,
+        registrations,
     }
+}
+
+/// The index of `frame` in `frames`, which holds it.
+fn frame_index(frames: &[Frame], frame: &Frame) -> usize {
+    frames
+        .iter()
+        .position(|f| std::ptr::eq(f, frame))
+        .expect("a registration's frame is one of the station's frames")
 }
 
 /// The landmarks of the registered frames, none anchored at this station, that lie within

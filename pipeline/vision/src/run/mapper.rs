@@ -4,8 +4,8 @@
 //! nothing are mapped again when later stations change the map.
 
 use super::record::{
-    Association, DetectionRecord, Exclusion, LateSighting, MetricsRecord, RangeRecord, SplitRecord,
-    StationRecord,
+    Association, DetectionRecord, Exclusion, LateSighting, MetricsRecord, RangeRecord,
+    RegistrationRecord, SplitRecord, StationRecord,
 };
 use super::selection;
 use crate::association::audit::{regroup, Regrouping};
@@ -121,6 +121,7 @@ struct Decided {
     /// The held-back observations of earlier stations its matches recognise, with the
     /// station of each.
     recognitions: Vec<(usize, Recognition)>,
+    registrations: Vec<RegistrationRecord>,
 }
 
 /// The map being built and what association needs to remember.
@@ -335,9 +336,20 @@ impl<C: Calculus> Mapper<C> {
             .filter(|r| decisions[r.detection] == Decision::Matched(r.landmark))
             .filter_map(|r| Some((stations[r.frame]?, r)))
             .collect();
+        let registrations = association
+            .registrations
+            .into_iter()
+            .map(|r| RegistrationRecord {
+                frame: stations[r.frame],
+                pairs: r.pairs.iter().map(|&(i, l)| (usable[i], l)).collect(),
+                nfa: Some(r.nfa).filter(|nfa| nfa.is_finite()),
+                believed: r.believed,
+            })
+            .collect();
         Decided {
             associated: Associated::new(usable, evidence, decisions, self.next_landmark),
             recognitions,
+            registrations,
         }
     }
 
@@ -354,7 +366,9 @@ impl<C: Calculus> Mapper<C> {
         let Decided {
             associated,
             recognitions,
+            registrations,
         } = decided;
+        record.registrations = registrations;
         for (position, decision) in associated.decisions.iter().enumerate() {
             if let Decision::Withheld(why) = decision {
                 record.detections[associated.usable[position]].association = Association::Unused {

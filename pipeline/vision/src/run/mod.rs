@@ -15,5 +15,5 @@ pub use traverse::{traverse_survey, Progress, Quiet, RunError, RunSettings, Stag
 
 pub use record::{
     Association, DetectionRecord, Exclusion, FusionRecord, LateSighting, MetricsRecord,
-    RangeRecord, StageSeconds, StationRecord,
+    RangeRecord, RegistrationRecord, StageSeconds, StationRecord,
 };

@@ -29,6 +29,10 @@ pub struct StationRecord {
     pub detections: Vec<DetectionRecord>,
     /// The asserted "nearer than" pairs `(i, j)`: detection `i` is nearer than detection `j`.
     pub order: Vec<(usize, usize)>,
+    /// Every earlier frame its detections registered against, believed or not: why they were
+    /// anchored or held back (000 §VI-C).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub registrations: Vec<RegistrationRecord>,
     /// The outcome of fusing this panorama into the map.
     pub fusion: FusionRecord,
     /// The map after this panorama.
@@ -37,6 +41,24 @@ pub struct StationRecord {
     pub seconds: StageSeconds,
     /// Warnings about this station (skipped images, too few detections, …).
     pub warnings: Vec<String>,
+}
+
+/// One registration of a station's detections against a frame: the rigid motion fitted to
+/// detections and landmarks that look alike (`association::register`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RegistrationRecord {
+    /// The station whose frame it registered against; `None` for the sketch of recent
+    /// stations' landmarks (`association::Sketch`).
+    pub frame: Option<usize>,
+    /// `(detection, landmark)` pairs, detections numbered as in `detections`: those anchors
+    /// were drawn from when believed, else the fit's own.
+    pub pairs: Vec<(usize, LandmarkId)>,
+    /// The fit's number of false alarms: how many fits as tight the hypotheses tried would
+    /// give by chance (`association::significance`); `null` in JSON when unbounded.
+    pub nfa: Option<f64>,
+    /// Whether association believed it (NFA below 1, enough pairs left, and not a lone fit
+    /// other frames should have confirmed): only a believed registration's pairs can anchor.
+    pub believed: bool,
 }
 
 /// One detection, its bearing, its range evidence and what association decided.
