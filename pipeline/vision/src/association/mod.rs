@@ -429,7 +429,7 @@ pub fn associate<C: Calculus>(
         .map(|(frame, fit)| {
             let kept = registrations
                 .iter()
-                .find(|(f, _)| frame_index(frames, f) == frame);
+                .find(|(f, _)| std::ptr::eq(*f, &frames[frame]));
             let (registration, believed) = kept.map_or((fit, false), |(_, r)| (r.clone(), true));
             FrameRegistration {
                 frame,
