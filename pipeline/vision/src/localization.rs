@@ -94,6 +94,7 @@ impl<C: Calculus> KnownMap<C> {
             .map(|record| Frame {
                 accumulated: false,
                 departed: Vec::new(),
+                tracks: Vec::new(),
                 unmapped: Vec::new(),
                 landmarks: record
                     .detections

@@ -116,6 +116,7 @@ mod tests {
         Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: points
                 .iter()

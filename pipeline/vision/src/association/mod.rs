@@ -401,10 +401,25 @@ pub fn associate<C: Calculus>(
         .map(|i| match anchored.iter().find(|a| a.position == i) {
             Some(anchor) => Decision::Matched(anchor.landmark),
             None => {
+                // A rock the sketch followed, unmapped, over several stations and placed apart
+                // from every landmark is a rock of its own: a detection placed on it founds
+                // its landmark though look-alikes remain where its placement reaches. Else a
+                // rock held back for a landmark nearby is never founded (colour marsyard
+                // seed 41: two rocks of a cluster, 1–2.7 m from four landmarks, each seen
+                // from over 40 stations; stop 74, docs/RUN.md).
+                let tracked = || {
+                    registrations
+                        .iter()
+                        .any(|(frame, r)| r.places_on_track(frame, &placed, i))
+                };
                 let survivors =
                     survivors(map, view, i, &candidates[i], &anchored, &recent, settings);
                 if !survivors.is_empty() {
-                    return Decision::HeldBack(survivors);
+                    return if tracked() {
+                        founded(&evidence[i])
+                    } else {
+                        Decision::HeldBack(survivors)
+                    };
                 }
                 // No look-alike is left, but a known landmark that no detection of this
                 // station is anchored to lies where the detection is: most likely its own
@@ -416,7 +431,7 @@ pub fn associate<C: Calculus>(
                 let unaccounted = placed[i]
                     .map(|p| unaccounted_near(p, &registrations, &anchored))
                     .unwrap_or_default();
-                if unaccounted.is_empty() {
+                if unaccounted.is_empty() || tracked() {
                     founded(&evidence[i])
                 } else {
                     Decision::HeldBack(unaccounted)
@@ -1203,6 +1218,7 @@ mod tests {
         Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: points
                 .iter()
@@ -1229,6 +1245,7 @@ mod tests {
                 (4, at([40.0, 30.0])),
             ],
             unmapped: Vec::new(),
+            tracks: Vec::new(),
         };
         let registration = Registration {
             pairs: Vec::new(),
@@ -1373,6 +1390,7 @@ mod tests {
             accumulated: true,
             landmarks: vec![(0, at(q))],
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
         };
         let by_sketch = Registration {
@@ -1584,6 +1602,34 @@ mod tests {
         }
         assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
         assert_eq!(decisions[7], Decision::HeldBack(vec![6]));
+    }
+
+    #[test]
+    fn a_detection_on_a_track_apart_from_every_landmark_founds_a_landmark() {
+        // Detection 6 looks like landmark 6, 1.4 m from it: not near enough to anchor, but
+        // within the sketch's slack, so it is held back. Once the sketch has followed an
+        // unmapped rock where the detection lies, it is that rock, and new. A track that does
+        // not hold the detection decides nothing.
+        let mut points = FIELD.to_vec();
+        points.push([-1.0, 9.0]);
+        let station = station(&points);
+        let mut landmarks = FIELD.to_vec();
+        landmarks.push([0.4, 9.0]);
+        let mut sketch = Frame {
+            accumulated: true,
+            ..frame(&landmarks)
+        };
+        let decisions = associate_station(&station, std::slice::from_ref(&sketch));
+        assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
+        sketch.tracks = vec![at([-1.0, 9.0])];
+        let decisions = associate_station(&station, std::slice::from_ref(&sketch));
+        for (i, decision) in decisions.iter().take(6).enumerate() {
+            assert_eq!(*decision, Decision::Matched(i as LandmarkId));
+        }
+        assert_eq!(decisions[6], Decision::New);
+        sketch.tracks = vec![at([-1.0, 7.0])];
+        let decisions = associate_station(&station, std::slice::from_ref(&sketch));
+        assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
     }
 
     #[test]

@@ -87,6 +87,7 @@ mod tests {
         Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: vec![Placed::disc(FIELD[4], 0.3)],
             landmarks: (0..4)
                 .map(|k| (k as LandmarkId, Placed::disc(FIELD[k], 0.3)))

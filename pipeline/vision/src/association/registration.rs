@@ -32,6 +32,10 @@ pub struct Frame {
     /// never registered against, only used to rule out look-alikes far from where they can
     /// still be (empty for a station's frame).
     pub departed: Vec<(LandmarkId, Placed)>,
+    /// Unmapped rocks the sketch followed over several stations, placed apart from every
+    /// landmark (`super::Sketch`; empty for a station's frame): rocks of their own that a
+    /// detection placed there may found a landmark for ([`Registration::places_on_track`]).
+    pub tracks: Vec<Placed>,
 }
 
 impl Frame {
@@ -573,6 +577,37 @@ fn others_farther(
 }
 
 impl Registration {
+    /// Whether the motion places detection `i` (of the station's `placed`) on one of the
+    /// frame's tracks, and unambiguously, by the pairs' own test ([`unambiguous_pair`]): the
+    /// track lies within the detection's placement, every landmark of the frame (departed
+    /// ones too) and every other track clearly farther from the detection, and every other
+    /// placed detection clearly farther from the track. The detection is then that unmapped
+    /// rock, not a look-alike landmark its placement cannot rule out.
+    pub fn places_on_track(&self, frame: &Frame, placed: &[Option<Placed>], i: usize) -> bool {
+        let Some(p) = placed[i].filter(|p| p.reach() <= LONG_ANCHOR_RADIUS_M) else {
+            return false;
+        };
+        let motion = self.motion();
+        let mut within = frame
+            .tracks
+            .iter()
+            .filter(|t| motion.separation(&p, t).within());
+        let (Some(track), None) = (within.next(), within.next()) else {
+            return false;
+        };
+        let clear = UNIQUE * motion.separation(&p, track).distance + SLACK_M;
+        frame
+            .landmarks
+            .iter()
+            .chain(&frame.departed)
+            .all(|(_, q)| motion.separation(&p, q).distance > clear)
+            && frame
+                .tracks
+                .iter()
+                .all(|t| std::ptr::eq(t, track) || motion.separation(&p, t).distance > clear)
+            && others_farther(&motion, placed, i, track, clear, |_| true)
+    }
+
     /// Adds the pairs of the `observers` (detections that took no part in the fit: doubted
     /// by the detector) under the motion the others found, by the fit's own test of an
     /// unambiguous partner: the landmark, `alike` the observer and not paired already, lies
@@ -1413,6 +1448,7 @@ pub(super) mod tests {
         Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: FIELD
                 .iter()
@@ -1537,6 +1573,7 @@ pub(super) mod tests {
         let frame = |unmapped: [f64; 2], other: [f64; 2]| Frame {
             accumulated: true,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: vec![Placed::disc(unmapped, 0.3)],
             landmarks: vec![
                 (0, Placed::disc([10.0, 0.0], 0.3)),
@@ -1563,6 +1600,7 @@ pub(super) mod tests {
         Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: FIELD
                 .iter()
@@ -1634,6 +1672,7 @@ pub(super) mod tests {
         let frame = Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: rocks
                 .iter()
@@ -1779,6 +1818,7 @@ pub(super) mod tests {
         let frame = Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: (0..20).map(|k| (k as LandmarkId, place(12.0))).collect(),
         };
@@ -1860,6 +1900,7 @@ pub(super) mod tests {
         let frame = Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: field
                 .iter()
@@ -1900,6 +1941,7 @@ pub(super) mod tests {
         let frame = Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: FIELD
                 .iter()
@@ -1928,6 +1970,7 @@ pub(super) mod tests {
         let frame = Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: vec![(10, place([3.0, 1.0])), (11, place([5.0, -2.0]))],
         };
@@ -2016,6 +2059,7 @@ pub(super) mod tests {
         let frame = Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: FIELD
                 .iter()
@@ -2086,6 +2130,7 @@ pub(super) mod tests {
         let frame = Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: vec![(1, Placed::disc([1.0, 1.0], 0.1))],
         };

@@ -15,6 +15,11 @@
 //! where the sketch last put them (`Frame::departed`) until the sketch starts again, to rule
 //! out look-alikes far from there. The rocks the last few stations saw and did not map are
 //! kept too (`Frame::unmapped`): a far rock's placement may reach one of them.
+//!
+//! Those unmapped rocks are also followed over stations ([`Track`]), their placements averaged
+//! as a landmark's are: a rock that every station holds back for a look-alike landmark nearby
+//! is never founded otherwise, and a track seen from a few stations, placed apart from every
+//! landmark, is the evidence that it is a rock of its own (`super::associate`).
 
 use super::registration::{misfit, Frame, Motion};
 use super::Placed;
@@ -40,6 +45,11 @@ const MIN_SHARED: usize = 3;
 /// placement, not averaged, and only as right as that station's motion into the sketch.
 const UNMAPPED_WINDOW: usize = 5;
 
+/// Fewest stations whose placements of an unmapped rock make its track one that founds a
+/// landmark: two crossing bearings place it, a third confirms. (2, 3 and 4 measured at stop 74:
+/// docs/RUN.md.)
+const TRACK_STATIONS: usize = 3;
+
 /// A landmark's position in the sketch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Sketched {
@@ -63,6 +73,19 @@ pub struct Sketch {
     updated: Option<usize>,
     /// Rocks recent stations saw that no landmark holds, by the station that saw them.
     unmapped: Vec<(usize, Placed)>,
+    tracks: Vec<Track>,
+}
+
+/// An unmapped rock followed over stations: the placements of it that no landmark holds,
+/// averaged as a landmark's are ([`average`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Track {
+    placed: Placed,
+    weight: Matrix2<f64>,
+    /// The last station that placed it.
+    seen: usize,
+    /// How many stations placed it.
+    stations: usize,
 }
 
 impl Sketch {
@@ -90,7 +113,26 @@ impl Sketch {
                 .filter(|(seen, _)| station <= seen + UNMAPPED_WINDOW)
                 .map(|(_, placed)| *placed)
                 .collect(),
+            tracks: self.founding_tracks(station),
         }
+    }
+
+    /// The tracks that may found a landmark at `station`: placed by [`TRACK_STATIONS`]
+    /// stations, one of them within [`UNMAPPED_WINDOW`], and apart from every landmark of the
+    /// sketch (a track where a landmark lies is most likely that landmark's rock, held back).
+    fn founding_tracks(&self, station: usize) -> Vec<Placed> {
+        let identity = Motion::identity();
+        self.tracks
+            .iter()
+            .filter(|t| t.stations >= TRACK_STATIONS && station <= t.seen + UNMAPPED_WINDOW)
+            .filter(|t| {
+                self.landmarks
+                    .iter()
+                    .chain(&self.departed)
+                    .all(|s| misfit(&identity, t.placed, s.placed) > 0.0)
+            })
+            .map(|t| t.placed)
+            .collect()
     }
 
     /// Forgets where `landmark` is: its sightings were found to show more than one rock.
@@ -119,6 +161,7 @@ impl Sketch {
                 self.landmarks.clear();
                 self.departed.clear();
                 self.unmapped.clear();
+                self.tracks.clear();
                 Motion::identity()
             }
             None => return false,
@@ -129,11 +172,15 @@ impl Sketch {
         }
         self.unmapped
             .retain(|(seen, _)| station <= seen + UNMAPPED_WINDOW);
-        self.unmapped.extend(
-            unmapped
-                .iter()
-                .map(|p| (station, motion.apply_placed(p).at_least(MIN_RADIUS_M))),
-        );
+        let unmapped: Vec<Placed> = unmapped
+            .iter()
+            .map(|p| motion.apply_placed(p).at_least(MIN_RADIUS_M))
+            .collect();
+        self.unmapped.extend(unmapped.iter().map(|&p| (station, p)));
+        self.tracks.retain(|t| station <= t.seen + WINDOW);
+        for placed in unmapped {
+            self.follow(placed, station);
+        }
         let (kept, departed): (Vec<Sketched>, Vec<Sketched>) = std::mem::take(&mut self.landmarks)
             .into_iter()
             .partition(|s| station <= s.seen + WINDOW);
@@ -171,21 +218,12 @@ impl Sketch {
         match self.landmarks.iter_mut().find(|s| s.landmark == landmark) {
             Some(s) if misfit(&Motion::identity(), placed, s.placed) > 0.0 => {}
             Some(s) => {
-                let old = s.weight * DECAY;
-                let total = old + weight;
-                let Some(shape) = total.try_inverse() else {
-                    return;
-                };
-                let mixed = shape
-                    * (old * Vector2::from(s.placed.point) + weight * Vector2::from(placed.point));
-                s.placed = Placed {
-                    point: [mixed[0], mixed[1]],
-                    shape,
+                if let Some((placed, weight)) = average((s.placed, s.weight), (placed, weight)) {
+                    s.placed = placed;
+                    s.weight = weight;
+                    // A revisited station is older than the latest to see the landmark.
+                    s.seen = s.seen.max(station);
                 }
-                .at_least(MIN_RADIUS_M);
-                s.weight = total;
-                // A revisited station is older than the latest to see the landmark.
-                s.seen = s.seen.max(station);
             }
             None => self.landmarks.push(Sketched {
                 landmark,
@@ -195,6 +233,60 @@ impl Sketch {
             }),
         }
     }
+
+    /// Averages an unmapped rock's placement into the one track it fits, or starts a track
+    /// where it fits none. A placement that fits several tracks joins none: it may be either
+    /// rock.
+    fn follow(&mut self, placed: Placed, station: usize) {
+        let Some(weight) = placed.shape.try_inverse() else {
+            return;
+        };
+        let identity = Motion::identity();
+        let mut fitting = self
+            .tracks
+            .iter_mut()
+            .filter(|t| misfit(&identity, placed, t.placed) <= 0.0);
+        match (fitting.next(), fitting.next()) {
+            (None, _) => self.tracks.push(Track {
+                placed,
+                weight,
+                seen: station,
+                stations: 1,
+            }),
+            (Some(t), None) => {
+                if let Some((placed, weight)) = average((t.placed, t.weight), (placed, weight)) {
+                    t.placed = placed;
+                    t.weight = weight;
+                    // Pieces of one rock place it twice from one station.
+                    if t.seen != station {
+                        t.stations += 1;
+                    }
+                    t.seen = t.seen.max(station);
+                }
+            }
+            (Some(_), Some(_)) => {}
+        }
+    }
+}
+
+/// An estimate `(placed, weight)` with a new placement averaged in (inverse-variance: each
+/// ellipse's inverse weighs it, the old weight decayed by [`DECAY`]); none where the sum does
+/// not invert.
+fn average(
+    (old_placed, old_weight): (Placed, Matrix2<f64>),
+    (placed, weight): (Placed, Matrix2<f64>),
+) -> Option<(Placed, Matrix2<f64>)> {
+    let old = old_weight * DECAY;
+    let total = old + weight;
+    let shape = total.try_inverse()?;
+    let mixed =
+        shape * (old * Vector2::from(old_placed.point) + weight * Vector2::from(placed.point));
+    let placed = Placed {
+        point: [mixed[0], mixed[1]],
+        shape,
+    }
+    .at_least(MIN_RADIUS_M);
+    Some((placed, total))
 }
 
 #[cfg(test)]
@@ -297,6 +389,69 @@ mod tests {
         let placed = sketch.frame(2).landmarks[0].1;
         assert!(distance(placed.point, rock) < 0.2, "{placed:?}");
         assert!(placed.reach() < 0.4, "{placed:?}");
+    }
+
+    /// Three landmarks, tightly placed, that fix every station's motion into the sketch
+    /// (here no motion at all).
+    fn fixed() -> Vec<(LandmarkId, Placed)> {
+        [[-3.0, 2.0], [1.0, -5.0], [-4.0, -4.0]]
+            .into_iter()
+            .enumerate()
+            .map(|(l, p)| (l as LandmarkId, Placed::disc(p, 0.05)))
+            .collect()
+    }
+
+    /// A rock at `rock` placed from `from`, `error` metres off along the bearing, 2 m deep and
+    /// 5 cm wide.
+    fn placed_from(rock: [f64; 2], from: [f64; 2], error: f64) -> Placed {
+        let angle = (rock[1] - from[1]).atan2(rock[0] - from[0]);
+        let point = [rock[0] + error * angle.cos(), rock[1] + error * angle.sin()];
+        Placed::along(point, angle, 2.0, 0.05)
+    }
+
+    /// A rock no landmark holds, placed by three stations along crossing bearings, is followed
+    /// where they cross and offered to found a landmark from the third on, until no station
+    /// has placed it for [`UNMAPPED_WINDOW`] stations.
+    #[test]
+    fn an_unmapped_rock_placed_by_three_stations_is_a_track() {
+        let rock = [4.0, 3.0];
+        let mut sketch = Sketch::default();
+        let views = [([0.0, 0.0], 1.5), ([8.0, 0.0], -1.5), ([4.0, -6.0], 1.0)];
+        for (station, (from, error)) in views.into_iter().enumerate() {
+            assert!(sketch.frame(station).tracks.is_empty(), "station {station}");
+            sketch.update(station, &fixed(), &[placed_from(rock, from, error)]);
+        }
+        let tracks = sketch.frame(3).tracks;
+        assert_eq!(tracks.len(), 1);
+        assert!(distance(tracks[0].point, rock) < 0.2, "{tracks:?}");
+        assert!(tracks[0].reach() < 0.4, "{tracks:?}");
+        assert_eq!(sketch.frame(2 + UNMAPPED_WINDOW).tracks.len(), 1);
+        assert!(sketch.frame(3 + UNMAPPED_WINDOW).tracks.is_empty());
+    }
+
+    /// Where a landmark lies, a track is most likely its rock held back: not offered. Nor is a
+    /// rock two pieces place twice from one station followed as seen from two.
+    #[test]
+    fn a_track_where_a_landmark_lies_or_seen_from_fewer_stations_founds_nothing() {
+        let rock = [4.0, 3.0];
+        let mut landmarks = fixed();
+        landmarks.push((9, Placed::disc(rock, 0.3)));
+        let mut sketch = Sketch::default();
+        for (station, from) in [[0.0, 0.0], [8.0, 0.0], [4.0, -6.0]]
+            .into_iter()
+            .enumerate()
+        {
+            sketch.update(station, &landmarks, &[placed_from(rock, from, 0.5)]);
+        }
+        assert!(sketch.frame(3).tracks.is_empty());
+        let mut sketch = Sketch::default();
+        let pieces = [
+            placed_from(rock, [0.0, 0.0], 0.3),
+            placed_from(rock, [0.0, 0.0], -0.3),
+        ];
+        sketch.update(0, &fixed(), &pieces);
+        sketch.update(1, &fixed(), &[placed_from(rock, [8.0, 0.0], 0.0)]);
+        assert!(sketch.frame(2).tracks.is_empty());
     }
 
     #[test]

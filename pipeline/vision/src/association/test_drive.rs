@@ -96,6 +96,7 @@ impl Seen {
         Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: Vec::new(),
             landmarks: self
                 .rocks

@@ -1116,6 +1116,7 @@ impl Associated {
         Frame {
             accumulated: false,
             departed: Vec::new(),
+            tracks: Vec::new(),
             unmapped: self.unmapped(),
             landmarks: self
                 .fused
@@ -1241,6 +1242,7 @@ mod tests {
                 unmapped: vec![placed(2.0), placed(3.0)],
                 accumulated: false,
                 departed: Vec::new(),
+                tracks: Vec::new(),
             },
         };
         sighted.found_late(7, Bearing::exact(0.5), Some(placed(3.0)));
