@@ -73,6 +73,8 @@ pub struct Sketch {
     updated: Option<usize>,
     /// Rocks recent stations saw that no landmark holds, by the station that saw them.
     unmapped: Vec<(usize, Placed)>,
+    /// The same rocks followed over stations, for [`WINDOW`] stations after one last placed
+    /// them.
     tracks: Vec<Track>,
 }
 
