@@ -59,7 +59,7 @@ pub use gallery::{distance, AppearanceScales, Gallery, Profile};
 pub use placement::Placed;
 pub use recency::LastSeen;
 pub use recognition::Recognition;
-pub use registration::{displacement, register, Frame, Registration};
+pub use registration::{displacement, register, Frame, Registration, Tracked};
 use registration::{ANCHOR_RADIUS_M, LONG_ANCHOR_RADIUS_M, MIN_INLIERS, SIGNIFICANT_NFA};
 pub use sketch::Sketch;
 
@@ -226,7 +226,8 @@ pub struct FrameRegistration {
     /// Index into the frames association was given.
     pub frame: usize,
     /// `(detection, landmark)`, detections by index into the station's evidence: the pairs
-    /// anchors were drawn from when believed, else the fit's own.
+    /// matches were drawn from when believed (anchors, and detections it placed on their
+    /// landmark's track), else the fit's own.
     pub pairs: Vec<(usize, LandmarkId)>,
     /// The fit's number of false alarms ([`Registration::nfa`]).
     pub nfa: f64,
@@ -396,29 +397,45 @@ pub fn associate<C: Calculus>(
     let recognitions =
         recognition::recognitions(frames, &registrations, &placed, &doubtful, &anchored);
     let recent = |l: LandmarkId| frames.iter().any(|f| f.landmarks.iter().any(|m| m.0 == l));
-    let decisions = (0..n)
+    let decisions: Vec<Decision> = (0..n)
         .into_par_iter()
         .map(|i| match anchored.iter().find(|a| a.position == i) {
             Some(anchor) => Decision::Matched(anchor.landmark),
             None => {
-                // A rock the sketch followed, unmapped, over several stations and placed apart
-                // from every landmark is a rock of its own: a detection placed on it founds
-                // its landmark though look-alikes remain where its placement reaches. Else a
+                // Where the sketch followed something unmapped over several stations
+                // ([`Tracked`]) and a registration places the detection on it, the track
+                // decides what look-alikes within the placement could not. Apart from every
+                // landmark, it is a rock of its own: the detection founds its landmark. Else a
                 // rock held back for a landmark nearby is never founded (colour marsyard
                 // seed 41: two rocks of a cluster, 1–2.7 m from four landmarks, each seen
                 // from over 40 stations; stop 74, docs/RUN.md).
-                let tracked = || {
+                let track = || {
                     registrations
                         .iter()
-                        .any(|(frame, r)| r.places_on_track(frame, &placed, i))
+                        .find_map(|(frame, r)| r.track_of(frame, &placed, i))
                 };
                 let survivors =
                     survivors(map, view, i, &candidates[i], &anchored, &recent, settings);
                 if !survivors.is_empty() {
-                    return if tracked() {
-                        founded(&evidence[i])
-                    } else {
-                        Decision::HeldBack(survivors)
+                    return match track().map(|t| t.landmark) {
+                        Some(None) => founded(&evidence[i]),
+                        // Fitting a landmark the map does not reject, it is that landmark's
+                        // rock, held back before: matched, for a whole detection seen in
+                        // colour. A piece's placement spans its neighbour, so its placements
+                        // track the two rocks blended (stress seed 4: purity 0.956 → 0.928
+                        // with pieces matched too, unchanged without); by luminance, look-alikes
+                        // a few decimetres apart blend as well (stress seed 9: purity 0.952 →
+                        // 0.945, a mixed landmark's wrong sightings 8 → 11; stop 74,
+                        // docs/RUN.md).
+                        Some(Some(l))
+                            if station.colour
+                                && survivors.contains(&l)
+                                && !evidence[i].piece
+                                && !evidence[i].doubtful =>
+                        {
+                            Decision::Matched(l)
+                        }
+                        _ => Decision::HeldBack(survivors),
                     };
                 }
                 // No look-alike is left, but a known landmark that no detection of this
@@ -431,12 +448,26 @@ pub fn associate<C: Calculus>(
                 let unaccounted = placed[i]
                     .map(|p| unaccounted_near(p, &registrations, &anchored))
                     .unwrap_or_default();
-                if unaccounted.is_empty() || tracked() {
+                if unaccounted.is_empty() || track().is_some_and(|t| t.landmark.is_none()) {
                     founded(&evidence[i])
                 } else {
                     Decision::HeldBack(unaccounted)
                 }
             }
+        })
+        .collect();
+    // The matches a registration made by placing the detection on its landmark's track, as
+    // the decisions found them: each recorded with that registration's pairs.
+    let on_tracks: Vec<(&Frame, usize, LandmarkId)> = decisions
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| !anchored.iter().any(|a| a.position == i))
+        .filter_map(|(i, decision)| match *decision {
+            Decision::Matched(l) => registrations.iter().find_map(|(frame, r)| {
+                let track = r.track_of(frame, &placed, i)?;
+                (track.landmark == Some(l)).then_some((*frame, i, l))
+            }),
+            _ => None,
         })
         .collect();
     let registrations = found
@@ -446,9 +477,18 @@ pub fn associate<C: Calculus>(
                 .iter()
                 .find(|(f, _)| std::ptr::eq(*f, &frames[frame]));
             let (registration, believed) = kept.map_or((fit, false), |(_, r)| (r.clone(), true));
+            let mut pairs = registration.pairs;
+            if believed {
+                pairs.extend(
+                    on_tracks
+                        .iter()
+                        .filter(|(f, _, _)| std::ptr::eq(*f, &frames[frame]))
+                        .map(|&(_, i, l)| (i, l)),
+                );
+            }
             FrameRegistration {
                 frame,
-                pairs: registration.pairs,
+                pairs,
                 nfa: registration.nfa,
                 believed,
             }
@@ -1621,15 +1661,55 @@ mod tests {
         };
         let decisions = associate_station(&station, std::slice::from_ref(&sketch));
         assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
-        sketch.tracks = vec![at([-1.0, 9.0])];
+        sketch.tracks = vec![Tracked {
+            placed: at([-1.0, 9.0]),
+            landmark: None,
+        }];
         let decisions = associate_station(&station, std::slice::from_ref(&sketch));
         for (i, decision) in decisions.iter().take(6).enumerate() {
             assert_eq!(*decision, Decision::Matched(i as LandmarkId));
         }
         assert_eq!(decisions[6], Decision::New);
-        sketch.tracks = vec![at([-1.0, 7.0])];
+        sketch.tracks = vec![Tracked {
+            placed: at([-1.0, 7.0]),
+            landmark: None,
+        }];
         let decisions = associate_station(&station, std::slice::from_ref(&sketch));
         assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
+    }
+
+    #[test]
+    fn a_whole_detection_on_a_landmarks_track_is_matched_and_a_piece_held_back() {
+        // Detection 6 looks like landmark 6, 1.1 m from it, but landmark 7 lies 1.2 m from it:
+        // not clearly farther, so the pair does not anchor and the detection is held back. The
+        // sketch followed something held back where the detection lies, and the track fits
+        // landmark 6 alone: the detection is that rock. A piece's placement spans its
+        // neighbour, so a piece stays held back.
+        let mut points = FIELD.to_vec();
+        points.push([-1.0, 9.0]);
+        let mut station = station(&points);
+        let mut landmarks = FIELD.to_vec();
+        landmarks.extend([[0.1, 9.0], [-1.0, 10.2]]);
+        let mut sketch = Frame {
+            accumulated: true,
+            ..frame(&landmarks)
+        };
+        let decisions = associate_station(&station, std::slice::from_ref(&sketch));
+        assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
+        sketch.tracks = vec![Tracked {
+            placed: at([-0.9, 9.0]),
+            landmark: Some(6),
+        }];
+        let decisions = associate_station(&station, std::slice::from_ref(&sketch));
+        for (i, decision) in decisions.iter().enumerate() {
+            assert_eq!(*decision, Decision::Matched(i as LandmarkId));
+        }
+        station.1.detections[6].piece = true;
+        let decisions = associate_station(&station, std::slice::from_ref(&sketch));
+        assert!(
+            matches!(decisions[6], Decision::HeldBack(_)),
+            "{decisions:?}"
+        );
     }
 
     #[test]

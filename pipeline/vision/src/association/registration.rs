@@ -32,10 +32,21 @@ pub struct Frame {
     /// never registered against, only used to rule out look-alikes far from where they can
     /// still be (empty for a station's frame).
     pub departed: Vec<(LandmarkId, Placed)>,
-    /// Unmapped rocks the sketch followed over several stations, placed apart from every
-    /// landmark (`super::Sketch`; empty for a station's frame): rocks of their own that a
-    /// detection placed there may found a landmark for ([`Registration::places_on_track`]).
-    pub tracks: Vec<Placed>,
+    /// Unmapped rocks the sketch followed over several stations (`super::Sketch`; empty for a
+    /// station's frame): where a detection placed on one belongs ([`Registration::track_of`]).
+    pub tracks: Vec<Tracked>,
+}
+
+/// An unmapped rock the sketch followed over several stations, where stations saw something
+/// and mapped no landmark for it, and the landmark whose placement it fits if one alone does.
+/// Apart from every landmark, it is a rock of its own. Fitting one, it is most likely that
+/// landmark's rock, held back station after station; its placements, averaged, say where
+/// stations see that rock, which its landmark's own placement may not (a piece's range, a
+/// lit face).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tracked {
+    pub placed: Placed,
+    pub landmark: Option<LandmarkId>,
 }
 
 impl Frame {
@@ -577,35 +588,33 @@ fn others_farther(
 }
 
 impl Registration {
-    /// Whether the motion places detection `i` (of the station's `placed`) on one of the
-    /// frame's tracks, and unambiguously, by the pairs' own test ([`unambiguous_pair`]): the
-    /// track lies within the detection's placement, every landmark of the frame (departed
-    /// ones too) and every other track clearly farther from the detection, and every other
-    /// placed detection clearly farther from the track. The detection is then that unmapped
-    /// rock, not a look-alike landmark its placement cannot rule out.
-    pub fn places_on_track(&self, frame: &Frame, placed: &[Option<Placed>], i: usize) -> bool {
-        let Some(p) = placed[i].filter(|p| p.reach() <= LONG_ANCHOR_RADIUS_M) else {
-            return false;
-        };
+    /// The track of the frame the motion places detection `i` (of the station's `placed`) on,
+    /// unambiguously, by the pairs' own test ([`unambiguous_pair`]): the track lies within the
+    /// detection's placement, every landmark of the frame but the track's own (departed ones
+    /// too) and every other track clearly farther from the detection, and every other placed
+    /// detection clearly farther from the track.
+    pub fn track_of(&self, frame: &Frame, placed: &[Option<Placed>], i: usize) -> Option<Tracked> {
+        let p = placed[i].filter(|p| p.reach() <= LONG_ANCHOR_RADIUS_M)?;
         let motion = self.motion();
         let mut within = frame
             .tracks
             .iter()
-            .filter(|t| motion.separation(&p, t).within());
+            .filter(|t| motion.separation(&p, &t.placed).within());
         let (Some(track), None) = (within.next(), within.next()) else {
-            return false;
+            return None;
         };
-        let clear = UNIQUE * motion.separation(&p, track).distance + SLACK_M;
-        frame
+        let clear = UNIQUE * motion.separation(&p, &track.placed).distance + SLACK_M;
+        let unambiguous = frame
             .landmarks
             .iter()
             .chain(&frame.departed)
+            .filter(|(l, _)| track.landmark != Some(*l))
             .all(|(_, q)| motion.separation(&p, q).distance > clear)
-            && frame
-                .tracks
-                .iter()
-                .all(|t| std::ptr::eq(t, track) || motion.separation(&p, t).distance > clear)
-            && others_farther(&motion, placed, i, track, clear, |_| true)
+            && frame.tracks.iter().all(|t| {
+                std::ptr::eq(t, track) || motion.separation(&p, &t.placed).distance > clear
+            })
+            && others_farther(&motion, placed, i, &track.placed, clear, |_| true);
+        unambiguous.then_some(*track)
     }
 
     /// Adds the pairs of the `observers` (detections that took no part in the fit: doubted

@@ -21,7 +21,7 @@
 //! is never founded otherwise, and a track seen from a few stations, placed apart from every
 //! landmark, is the evidence that it is a rock of its own (`super::associate`).
 
-use super::registration::{misfit, Frame, Motion};
+use super::registration::{misfit, Frame, Motion, Tracked};
 use super::Placed;
 use nalgebra::{Matrix2, Vector2};
 use qrm_core::map::LandmarkId;
@@ -115,25 +115,35 @@ impl Sketch {
                 .filter(|(seen, _)| station <= seen + UNMAPPED_WINDOW)
                 .map(|(_, placed)| *placed)
                 .collect(),
-            tracks: self.founding_tracks(station),
+            tracks: self.offered_tracks(station),
         }
     }
 
-    /// The tracks that may found a landmark at `station`: placed by [`TRACK_STATIONS`]
-    /// stations, one of them within [`UNMAPPED_WINDOW`], and apart from every landmark of the
-    /// sketch (a track where a landmark lies is most likely that landmark's rock, held back).
-    fn founding_tracks(&self, station: usize) -> Vec<Placed> {
+    /// The tracks offered at `station`: placed by [`TRACK_STATIONS`] stations, one of them
+    /// within [`UNMAPPED_WINDOW`], each apart from every landmark of the sketch (departed ones
+    /// too) or fitting one landmark in view alone. A track that fits several may be any of
+    /// their rocks.
+    fn offered_tracks(&self, station: usize) -> Vec<Tracked> {
         let identity = Motion::identity();
         self.tracks
             .iter()
             .filter(|t| t.stations >= TRACK_STATIONS && station <= t.seen + UNMAPPED_WINDOW)
-            .filter(|t| {
-                self.landmarks
+            .filter_map(|t| {
+                let mut fitting = self
+                    .landmarks
                     .iter()
                     .chain(&self.departed)
-                    .all(|s| misfit(&identity, t.placed, s.placed) > 0.0)
+                    .filter(|s| misfit(&identity, t.placed, s.placed) <= 0.0);
+                let landmark = match (fitting.next(), fitting.next()) {
+                    (None, _) => None,
+                    (Some(s), None) if station <= s.seen + WINDOW => Some(s.landmark),
+                    _ => return None,
+                };
+                Some(Tracked {
+                    placed: t.placed,
+                    landmark,
+                })
             })
-            .map(|t| t.placed)
             .collect()
     }
 
@@ -425,27 +435,37 @@ mod tests {
         }
         let tracks = sketch.frame(3).tracks;
         assert_eq!(tracks.len(), 1);
-        assert!(distance(tracks[0].point, rock) < 0.2, "{tracks:?}");
-        assert!(tracks[0].reach() < 0.4, "{tracks:?}");
+        assert_eq!(tracks[0].landmark, None, "apart from every landmark");
+        assert!(distance(tracks[0].placed.point, rock) < 0.2, "{tracks:?}");
+        assert!(tracks[0].placed.reach() < 0.4, "{tracks:?}");
         assert_eq!(sketch.frame(2 + UNMAPPED_WINDOW).tracks.len(), 1);
         assert!(sketch.frame(3 + UNMAPPED_WINDOW).tracks.is_empty());
     }
 
-    /// Where a landmark lies, a track is most likely its rock held back: not offered. Nor is a
-    /// rock two pieces place twice from one station followed as seen from two.
+    /// Where one landmark lies, a track is most likely its rock, held back: offered with that
+    /// landmark. Where two lie, it may be either rock's: not offered. Nor is a rock two pieces
+    /// place twice from one station followed as seen from two.
     #[test]
-    fn a_track_where_a_landmark_lies_or_seen_from_fewer_stations_founds_nothing() {
+    fn a_track_where_landmarks_lie_is_theirs_and_one_seen_from_fewer_stations_is_none() {
         let rock = [4.0, 3.0];
-        let mut landmarks = fixed();
-        landmarks.push((9, Placed::disc(rock, 0.3)));
-        let mut sketch = Sketch::default();
-        for (station, from) in [[0.0, 0.0], [8.0, 0.0], [4.0, -6.0]]
-            .into_iter()
-            .enumerate()
-        {
-            sketch.update(station, &landmarks, &[placed_from(rock, from, 0.5)]);
-        }
-        assert!(sketch.frame(3).tracks.is_empty());
+        let track_among = |extra: &[(LandmarkId, Placed)]| {
+            let mut landmarks = fixed();
+            landmarks.extend_from_slice(extra);
+            let mut sketch = Sketch::default();
+            let views = [[0.0, 0.0], [8.0, 0.0], [4.0, -6.0]];
+            for (station, from) in views.into_iter().enumerate() {
+                sketch.update(station, &landmarks, &[placed_from(rock, from, 0.5)]);
+            }
+            sketch.frame(3).tracks
+        };
+        let tracks = track_among(&[(9, Placed::disc([4.2, 3.0], 0.3))]);
+        assert_eq!(tracks.len(), 1);
+        assert_eq!(tracks[0].landmark, Some(9));
+        let two = [
+            (9, Placed::disc([4.2, 3.0], 0.3)),
+            (10, Placed::disc([3.8, 3.0], 0.3)),
+        ];
+        assert!(track_among(&two).is_empty());
         let mut sketch = Sketch::default();
         let pieces = [
             placed_from(rock, [0.0, 0.0], 0.3),

@@ -50,8 +50,9 @@ pub struct RegistrationRecord {
     /// The station whose frame it registered against; `None` for the sketch of recent
     /// stations' landmarks (`association::Sketch`).
     pub frame: Option<usize>,
-    /// `(detection, landmark)` pairs, detections numbered as in `detections`: those anchors
-    /// were drawn from when believed, else the fit's own.
+    /// `(detection, landmark)` pairs, detections numbered as in `detections`: those matches
+    /// were drawn from when believed (its anchors, and the detections it placed on a
+    /// landmark's track, `association::Tracked`), else the fit's own.
     pub pairs: Vec<(usize, LandmarkId)>,
     /// The fit's number of false alarms: how many fits as tight the hypotheses tried would
     /// give by chance (`association::significance`); `null` in JSON when unbounded.
