@@ -19,7 +19,8 @@
 //! Those unmapped rocks are also followed over stations ([`Track`]), their placements averaged
 //! as a landmark's are: a rock that every station holds back for a look-alike landmark nearby
 //! is never founded otherwise, and a track seen from a few stations, placed apart from every
-//! landmark, is the evidence that it is a rock of its own (`super::associate`).
+//! landmark, is the evidence that it is a rock of its own; one where a single landmark lies
+//! says where stations see that landmark's rock (`super::associate`).
 
 use super::registration::{misfit, Frame, Motion, Tracked};
 use super::Placed;
@@ -45,9 +46,9 @@ const MIN_SHARED: usize = 3;
 /// placement, not averaged, and only as right as that station's motion into the sketch.
 const UNMAPPED_WINDOW: usize = 5;
 
-/// Fewest stations whose placements of an unmapped rock make its track one that founds a
-/// landmark: two crossing bearings place it, a third confirms. (2, 3 and 4 measured at stop 74:
-/// docs/RUN.md.)
+/// Fewest stations whose placements of an unmapped rock make its track one that decides a
+/// detection's association: two crossing bearings place it, a third confirms. (2, 3 and 4
+/// measured at stop 74: docs/RUN.md.)
 const TRACK_STATIONS: usize = 3;
 
 /// A landmark's position in the sketch.
