@@ -1644,21 +1644,27 @@ mod tests {
         assert_eq!(decisions[7], Decision::HeldBack(vec![6]));
     }
 
+    /// The station seeing FIELD's rocks and rocks at `more`, all alike.
+    fn field_and(more: &[[f64; 2]]) -> (Gallery, StationEvidence) {
+        station(&[&FIELD[..], more].concat())
+    }
+
+    /// The sketch holding FIELD's rocks and rocks at `more` as landmarks 0, 1, ….
+    fn sketch_of_field_and(more: &[[f64; 2]]) -> Frame {
+        Frame {
+            accumulated: true,
+            ..frame(&[&FIELD[..], more].concat())
+        }
+    }
+
     #[test]
     fn a_detection_on_a_track_apart_from_every_landmark_founds_a_landmark() {
         // Detection 6 looks like landmark 6, 1.4 m from it: not near enough to anchor, but
         // within the sketch's slack, so it is held back. Once the sketch has followed an
         // unmapped rock where the detection lies, it is that rock, and new. A track that does
         // not hold the detection decides nothing.
-        let mut points = FIELD.to_vec();
-        points.push([-1.0, 9.0]);
-        let station = station(&points);
-        let mut landmarks = FIELD.to_vec();
-        landmarks.push([0.4, 9.0]);
-        let mut sketch = Frame {
-            accumulated: true,
-            ..frame(&landmarks)
-        };
+        let station = field_and(&[[-1.0, 9.0]]);
+        let mut sketch = sketch_of_field_and(&[[0.4, 9.0]]);
         let decisions = associate_station(&station, std::slice::from_ref(&sketch));
         assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
         sketch.tracks = vec![Tracked {
@@ -1685,15 +1691,8 @@ mod tests {
         // sketch followed something held back where the detection lies, and the track fits
         // landmark 6 alone: the detection is that rock. A piece's placement spans its
         // neighbour, so a piece stays held back.
-        let mut points = FIELD.to_vec();
-        points.push([-1.0, 9.0]);
-        let mut station = station(&points);
-        let mut landmarks = FIELD.to_vec();
-        landmarks.extend([[0.1, 9.0], [-1.0, 10.2]]);
-        let mut sketch = Frame {
-            accumulated: true,
-            ..frame(&landmarks)
-        };
+        let mut station = field_and(&[[-1.0, 9.0]]);
+        let mut sketch = sketch_of_field_and(&[[0.1, 9.0], [-1.0, 10.2]]);
         let decisions = associate_station(&station, std::slice::from_ref(&sketch));
         assert_eq!(decisions[6], Decision::HeldBack(vec![6]));
         sketch.tracks = vec![Tracked {
