@@ -122,7 +122,7 @@ def verify(path):
         believed = sum(1 for r in registrations if r.get("believed"))
         summary.append(f"  registrations {len(registrations)} ({believed} believed)")
         summary.append(f"  stations rejected by the map: {rejected}")
-        summary.append(f"  final map: {last.get('landmarks')} landmarks, {last.get('triples')} triples, "
+        summary.append(f"  the last station's map: {last.get('landmarks')} landmarks, {last.get('triples')} triples, "
                        f"open {last.get('open_fraction')}, fully constrained "
                        f"{last.get('fully_constrained_fraction')}, RNG cost {last.get('rng_cost')}")
     return problems, summary

@@ -161,6 +161,34 @@ impl<C: Calculus> Hypergraph<C> {
         k
     }
 
+    /// The map over the landmarks `keep` accepts, in this map's order: their relations as this
+    /// map holds them, copied edge by edge. A restriction of a path-consistent network is path
+    /// consistent, so nothing is fused or tightened; used to compare a map with ground truth on
+    /// the landmarks that have one, and to publish a run's map without its uncorroborated
+    /// landmarks. Kept landmarks keep their relative order, so every kept edge keeps its
+    /// slots; only the edges that left the universe are visited.
+    pub fn restricted(&self, keep: impl Fn(LandmarkId) -> bool) -> Hypergraph<C> {
+        let mut map = Hypergraph::new();
+        let mut new_index = vec![None; self.landmarks.len()];
+        for (old, &id) in self.landmarks.iter().enumerate() {
+            if keep(id) {
+                new_index[old] = Some(map.landmarks.len());
+                map.index.insert(id, map.landmarks.len());
+                map.landmarks.push(id);
+            }
+        }
+        map.edges = vec![[C::universe().bits(); 3]; choose3(map.landmarks.len())];
+        for &r in &self.constrained {
+            let [i, j, k] = unrank(r);
+            if let (Some(i), Some(j), Some(k)) = (new_index[i], new_index[j], new_index[k]) {
+                let new = rank(i, j, k);
+                map.edges[new] = self.edges[r];
+                map.constrained.push(new);
+            }
+        }
+        map
+    }
+
     /// Drops the landmarks from `count` on, with their edges.
     pub(super) fn truncate_landmarks(&mut self, count: usize) {
         for id in self.landmarks.drain(count..) {
@@ -299,3 +327,49 @@ impl Iterator for Triples<'_> {
 }
 
 impl ExactSizeIterator for Triples<'_> {}
+
+#[cfg(test)]
+mod tests {
+    use crate::edc::Edc;
+    use crate::geometry::Point;
+    use crate::map::testing::converged;
+    use crate::map::{Hypergraph, Observation};
+
+    #[test]
+    fn a_restriction_keeps_the_order_the_relations_and_unrelated_landmarks() {
+        let points = [
+            Point::new(0.3, 0.1),
+            Point::new(4.2, 1.7),
+            Point::new(1.1, 5.3),
+            Point::new(-3.4, 2.9),
+            Point::new(2.7, -3.8),
+            Point::new(-1.9, -2.3),
+            Point::new(6.1, 4.4),
+        ];
+        let mut map = converged::<Edc>(&points);
+        map.add_landmarks(&[9]);
+        let dropped = [1, 4];
+        let restricted = map.restricted(|l| !dropped.contains(&l));
+        assert_eq!(restricted.landmarks(), &[0, 2, 3, 5, 6, 9]);
+        assert_eq!(restricted.triple_count(), 20);
+        for (a, b, c, [ab_c, bc_a, ca_b]) in restricted.triples() {
+            assert_eq!(map.relation(a, b, c), Some(ab_c));
+            assert_eq!(map.relation(b, c, a), Some(bc_a));
+            assert_eq!(map.relation(c, a, b), Some(ca_b));
+        }
+        assert_eq!(restricted.relation(0, 1, 2), None);
+        // The same map as fusing the kept triples' relations into an empty one.
+        let kept: Vec<Observation> = map
+            .triples()
+            .filter(|&(a, b, c, _)| ![a, b, c].iter().any(|l| dropped.contains(l)))
+            .flat_map(|(a, b, c, r)| Observation::of_triple([a, b, c], r))
+            .collect();
+        let mut fused = Hypergraph::<Edc>::new();
+        fused.add_landmarks(&[0, 2, 3, 5, 6, 9]);
+        fused
+            .fuse(&kept)
+            .expect("a converged map's relations agree");
+        assert!(restricted == fused);
+        assert_eq!(restricted.constrained().len(), fused.constrained().len());
+    }
+}

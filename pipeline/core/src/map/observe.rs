@@ -55,21 +55,6 @@ impl<C: Calculus> Hypergraph<C> {
         self.measure(view, &triples)
     }
 
-    /// The map over the landmarks `keep` accepts: their relations as this map holds them. A
-    /// restriction of a path-consistent network is path consistent, so nothing tightens; used
-    /// to compare a map with ground truth on the landmarks that have one.
-    pub fn restricted(&self, keep: impl Fn(LandmarkId) -> bool) -> Hypergraph<C> {
-        let observations: Vec<Observation> = self
-            .triples()
-            .filter(|&(a, b, c, _)| keep(a) && keep(b) && keep(c))
-            .flat_map(|(a, b, c, r)| Observation::of_triple([a, b, c], r))
-            .collect();
-        let mut map = Hypergraph::new();
-        map.fuse(&observations)
-            .expect("relations of a consistent map are consistent");
-        map
-    }
-
     /// Measures `triples` in parallel; the observations come in the order of `triples`, as
     /// `AB:C, BC:A, CA:B` of each.
     fn measure(&self, view: &StationView, triples: &[[Sighting; 3]]) -> Vec<Observation> {

@@ -20,7 +20,7 @@ use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, Journal, LandmarkId, Sighting};
 use qrm_core::measurement::{Bearing, StationView};
 use qrm_core::neighborhood::{estimate, RngEstimate};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -148,6 +148,8 @@ pub struct Mapper<C: Calculus> {
     next_landmark: LandmarkId,
     /// `(station, detection) → landmark` for every fused detection, for evaluation.
     pub sightings: Vec<(usize, usize, LandmarkId)>,
+    /// Landmarks [`Mapper::finish`] left out of the map: fused from one station only.
+    pub uncorroborated: Vec<LandmarkId>,
     /// The RNG estimate after the latest station.
     rng: RngEstimate,
     /// Counts the changes of the map: a station that fused nothing new leaves it, and its
@@ -174,6 +176,7 @@ impl<C: Calculus> Mapper<C> {
             stalled: Vec::new(),
             next_landmark: 0,
             sightings: Vec::new(),
+            uncorroborated: Vec::new(),
             rng: RngEstimate::default(),
             revision: 0,
             metrics: None,
@@ -201,6 +204,47 @@ impl<C: Calculus> Mapper<C> {
     /// Observations still held back.
     pub fn held_back(&self) -> usize {
         self.held.len()
+    }
+
+    /// Ends the run: leaves out of the map every landmark fused from fewer than
+    /// [`CORROBORATING_STATIONS`] stations ([`Mapper::uncorroborated`]), and returns the
+    /// metrics of the map that remains, which the run publishes.
+    ///
+    /// A detection that founded a landmark and was never matched again from anywhere else is
+    /// mostly no rock but a blob of ground or shadow the stereo test could not call flat: on
+    /// the ten colour marsyard seeds, 21 landmarks were fused from one station only and none
+    /// was a rock (s17, s19 and s29: 4–5 each); on all 27 sets of stop 75's figures, 13 of 59
+    /// were, 5 of them second landmarks of rocks mapped already (docs/RUN.md, stage 8). Each
+    /// such landmark is a node of the RNG no later station can find, and its triples with
+    /// every other landmark have no true state. Leaving it out loses no soundness: the
+    /// relations kept are those the map holds, and path consistency through the dropped
+    /// landmark derived them from its own station's measurement, which the rock or ground
+    /// point it saw satisfies.
+    pub fn finish(&mut self) -> MetricsRecord {
+        let mut stations: BTreeMap<LandmarkId, BTreeSet<usize>> = BTreeMap::new();
+        for &(station, _, l) in &self.sightings {
+            stations.entry(l).or_default().insert(station);
+        }
+        let corroborated =
+            |l: LandmarkId| stations.get(&l).map_or(0, BTreeSet::len) >= CORROBORATING_STATIONS;
+        self.uncorroborated = self
+            .map
+            .landmarks()
+            .iter()
+            .copied()
+            .filter(|&l| !corroborated(l))
+            .collect();
+        if !self.uncorroborated.is_empty() {
+            self.map = self.map.restricted(corroborated);
+            self.gallery.profiles.retain(|p| corroborated(p.landmark));
+            self.sightings.retain(|s| corroborated(s.2));
+            for s in &mut self.sighted {
+                s.bearings.retain(|&l, _| corroborated(l));
+                s.frame.landmarks.retain(|&(l, _)| corroborated(l));
+            }
+            self.revision += 1;
+        }
+        self.refresh_metrics()
     }
 
     /// Maps one station; the record has everything but the decode/detect times.
@@ -1046,6 +1090,11 @@ impl<C: Calculus> Mapper<C> {
     }
 }
 
+/// Stations whose sightings a landmark must have been fused from for the published map to
+/// hold it ([`Mapper::finish`]): one other station that found the same rock is the least
+/// corroboration there is.
+const CORROBORATING_STATIONS: usize = 2;
+
 /// Recent stations registered against (a rover moves a few metres between stations: the most
 /// recent ones share most landmarks with the current one). Only stations that fused enough
 /// landmarks to register against count: with no registrable frame left, every rock would come
@@ -1490,5 +1539,61 @@ mod tests {
             record.fusion.splits[0].new_landmarks,
             Vec::<LandmarkId>::new()
         );
+    }
+
+    /// A landmark fused from one station only leaves the published map, its gallery, the
+    /// frames and the RNG; the landmarks fused from two or more stay, related as before.
+    #[test]
+    fn finishing_leaves_out_the_landmarks_fused_from_one_station_only() {
+        const ONCE: LandmarkId = 100;
+        let mut mapper = test_mapper();
+        let identity = |r: usize| r as LandmarkId;
+        fuse_unchecked(&mut mapper, 0, &seen(0, usize::MAX), identity);
+        fuse_unchecked(&mut mapper, 1, &seen(1, usize::MAX), identity);
+        let third = seen(2, usize::MAX);
+        let r = third.rocks[0];
+        fuse_unchecked(&mut mapper, 2, &third, |k| {
+            if k == r {
+                ONCE
+            } else {
+                k as LandmarkId
+            }
+        });
+        assert!(mapper.map.contains(ONCE));
+        let before = mapper.map.clone();
+        let published = mapper.finish();
+        // The rocks station 2 is the first to see are fused from it alone too.
+        let mut once: Vec<LandmarkId> = third
+            .rocks
+            .iter()
+            .filter(|&&k| k != r && (0..2).all(|step| !seen(step, usize::MAX).rocks.contains(&k)))
+            .map(|&k| k as LandmarkId)
+            .chain([ONCE])
+            .collect();
+        once.sort_unstable();
+        let mut uncorroborated = mapper.uncorroborated.clone();
+        uncorroborated.sort_unstable();
+        assert_eq!(uncorroborated, once);
+        assert!(mapper.map.contains(r as LandmarkId));
+        assert!(!mapper.map.contains(ONCE));
+        assert!(mapper.landmarks().iter().all(|l| l.landmark != ONCE));
+        assert!(mapper
+            .sighted
+            .iter()
+            .all(|s| !s.bearings.contains_key(&ONCE)
+                && s.frame.landmarks.iter().all(|&(l, _)| l != ONCE)));
+        assert_eq!(published.landmarks, before.len() - once.len());
+        assert_eq!(published.landmarks, mapper.map.len());
+        for (a, b, c, [ab_c, bc_a, ca_b]) in mapper.map.triples() {
+            assert_eq!(before.relation(a, b, c), Some(ab_c));
+            assert_eq!(before.relation(b, c, a), Some(bc_a));
+            assert_eq!(before.relation(c, a, b), Some(ca_b));
+        }
+        assert_eq!(unsound(&mapper.map, |l| l as usize), 0);
+        assert!(mapper
+            .rng()
+            .edges
+            .iter()
+            .all(|e| !once.contains(&e.a) && !once.contains(&e.b)));
     }
 }

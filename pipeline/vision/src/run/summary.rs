@@ -1,7 +1,7 @@
 //! The few numbers a user wants at the end of `pipeline run` (also `summary.json`).
 
 use super::mapper::Mapper;
-use super::record::{Association, StationRecord};
+use super::record::{Association, MetricsRecord, StationRecord};
 use crate::detection::Channels;
 use qrm_core::calculus::Calculus;
 use serde::{Deserialize, Serialize};
@@ -20,7 +20,11 @@ pub struct RunSummary {
     #[serde(default)]
     pub stations_unusable: usize,
     pub detections: usize,
+    /// Landmarks of the published map (map.json), and those left out of it as fused from one
+    /// station only (`Mapper::finish`).
     pub landmarks: usize,
+    #[serde(default)]
+    pub landmarks_uncorroborated: usize,
     pub triples: usize,
     pub open_fraction: f64,
     pub fully_constrained_fraction: f64,
@@ -102,14 +106,12 @@ impl RunSummary {
     pub fn of<C: Calculus>(
         records: &[StationRecord],
         mapper: &Mapper<C>,
+        published: &MetricsRecord,
         skipped: usize,
         wall_front_end: f64,
         wall_mapping: f64,
     ) -> RunSummary {
-        let last = records
-            .last()
-            .map(|r| r.metrics.clone())
-            .unwrap_or_default();
+        let last = published;
         let sum = |f: fn(&StationRecord) -> f64| records.iter().map(f).sum::<f64>();
         let revisited = || records.iter().flat_map(|r| &r.fusion.revisited);
         RunSummary {
@@ -122,6 +124,7 @@ impl RunSummary {
             stations_unusable: records.iter().filter(|r| r.fusion.usable < 3).count(),
             detections: records.iter().map(|r| r.detections.len()).sum(),
             landmarks: last.landmarks,
+            landmarks_uncorroborated: mapper.uncorroborated.len(),
             triples: last.triples,
             open_fraction: last.open_fraction,
             fully_constrained_fraction: last.fully_constrained_fraction,
@@ -179,6 +182,13 @@ impl fmt::Display for RunSummary {
             "{} stations ({} skipped), {} detections → {} landmarks, {} triples",
             self.stations, self.stations_skipped, self.detections, self.landmarks, self.triples
         )?;
+        if self.landmarks_uncorroborated > 0 {
+            writeln!(
+                f,
+                "{} more landmarks were fused from one station only and left out of map.json and landmarks.json",
+                self.landmarks_uncorroborated
+            )?;
+        }
         if self.stations_unusable > 0 {
             writeln!(
                 f,

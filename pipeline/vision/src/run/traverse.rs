@@ -7,7 +7,7 @@
 
 use super::front_end::{detect_station, FrontEndResult};
 use super::mapper::Mapper;
-use super::record::StationRecord;
+use super::record::{MetricsRecord, StationRecord};
 use super::summary::RunSummary;
 use crate::association::AssociationSettings;
 use crate::calib::Calibration;
@@ -73,7 +73,11 @@ pub enum RunError<E> {
 /// A mapped survey: the mapper (map, gallery, sightings), one record per mapped station, and
 /// the warnings of the stations that were skipped.
 pub struct Traverse<C: Calculus> {
+    /// The map as published ([`Mapper::finish`]).
     pub mapper: Mapper<C>,
+    /// Its metrics: the last station's record has those of the map before uncorroborated
+    /// landmarks were left out.
+    pub published: MetricsRecord,
     pub records: Vec<StationRecord>,
     pub skipped: Vec<String>,
     /// Wall time of detection, from the start to the last station detected, seconds.
@@ -89,6 +93,7 @@ impl<C: Calculus> Traverse<C> {
         RunSummary::of(
             &self.records,
             &self.mapper,
+            &self.published,
             self.skipped.len(),
             self.wall_front_end,
             self.wall_mapping,
@@ -161,8 +166,10 @@ pub fn traverse_survey<C: Calculus, S, E>(
         outcome
     })
     .map(|(records, skipped, wall_mapping, state)| {
+        let published = mapper.finish();
         let traverse = Traverse {
             mapper,
+            published,
             records,
             skipped,
             wall_front_end: *detected_at.lock().expect("no panics hold it"),
