@@ -1515,9 +1515,9 @@ fn directions_cases() -> Vec<Case> {
         .setup(demo_run),
         Case::new(
             "directions: no route on the legs the map proves",
-            "directions --run {dir}/out --from 0 --to 1 --samples 0",
+            "directions --run {dir}/out --from 0 --to 3 --samples 0",
             &[
-                "no route from landmark 0 to landmark 1",
+                "no route from landmark 0 to landmark 3",
                 "proven by the map",
                 "none chain there",
             ],
