@@ -111,7 +111,6 @@ impl RunSummary {
         wall_front_end: f64,
         wall_mapping: f64,
     ) -> RunSummary {
-        let last = published;
         let sum = |f: fn(&StationRecord) -> f64| records.iter().map(f).sum::<f64>();
         let revisited = || records.iter().flat_map(|r| &r.fusion.revisited);
         RunSummary {
@@ -123,11 +122,11 @@ impl RunSummary {
                 .count(),
             stations_unusable: records.iter().filter(|r| r.fusion.usable < 3).count(),
             detections: records.iter().map(|r| r.detections.len()).sum(),
-            landmarks: last.landmarks,
+            landmarks: published.landmarks,
             landmarks_uncorroborated: mapper.uncorroborated.len(),
-            triples: last.triples,
-            open_fraction: last.open_fraction,
-            fully_constrained_fraction: last.fully_constrained_fraction,
+            triples: published.triples,
+            open_fraction: published.open_fraction,
+            fully_constrained_fraction: published.fully_constrained_fraction,
             contradictions: records
                 .iter()
                 .filter(|r| r.fusion.contradiction.is_some())
@@ -157,8 +156,8 @@ impl RunSummary {
             },
             revisited_sightings: revisited().count(),
             expired_held_back: mapper.expired,
-            rng_certain: last.rng_certain,
-            rng_uncertain: last.rng_uncertain,
+            rng_certain: published.rng_certain,
+            rng_uncertain: published.rng_uncertain,
             seconds_decode: sum(|r| r.seconds.decode),
             seconds_detect: sum(|r| r.seconds.detect),
             seconds_range: sum(|r| r.seconds.range),
