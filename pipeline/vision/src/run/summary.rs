@@ -181,12 +181,16 @@ impl fmt::Display for RunSummary {
             "{} stations ({} skipped), {} detections → {} landmarks, {} triples",
             self.stations, self.stations_skipped, self.detections, self.landmarks, self.triples
         )?;
-        if self.landmarks_uncorroborated > 0 {
-            writeln!(
+        match self.landmarks_uncorroborated {
+            0 => {}
+            1 => writeln!(
                 f,
-                "{} more landmarks were fused from one station only and left out of map.json and landmarks.json",
-                self.landmarks_uncorroborated
-            )?;
+                "1 more landmark was fused from one station only and left out of map.json and landmarks.json"
+            )?,
+            n => writeln!(
+                f,
+                "{n} more landmarks were fused from one station only and left out of map.json and landmarks.json"
+            )?,
         }
         if self.stations_unusable > 0 {
             writeln!(
