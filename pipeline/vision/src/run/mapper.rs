@@ -237,14 +237,44 @@ impl<C: Calculus> Mapper<C> {
         if !self.uncorroborated.is_empty() {
             self.map = self.map.restricted(corroborated);
             self.gallery.profiles.retain(|p| corroborated(p.landmark));
-            self.sightings.retain(|s| corroborated(s.2));
-            for s in &mut self.sighted {
-                s.bearings.retain(|&l, _| corroborated(l));
-                s.frame.landmarks.retain(|&(l, _)| corroborated(l));
-            }
+            self.relabel_fused(|_, l| corroborated(l).then_some(l));
             self.revision += 1;
         }
         self.refresh_metrics()
+    }
+
+    /// Renames the landmarks of every record of what stations fused: their bearings and
+    /// frames, the fused sightings, and the fused partners of held-back observations. A
+    /// landmark fused at `station` as `l` becomes `relabel(station, l)`, or is dropped when
+    /// that is `None`.
+    fn relabel_fused(&mut self, relabel: impl Fn(usize, LandmarkId) -> Option<LandmarkId>) {
+        for s in &mut self.sighted {
+            let station = s.station;
+            s.frame.landmarks = s
+                .frame
+                .landmarks
+                .iter()
+                .filter_map(|&(l, p)| Some((relabel(station, l)?, p)))
+                .collect();
+            s.bearings = s
+                .bearings
+                .iter()
+                .filter_map(|(&l, &b)| Some((relabel(station, l)?, b)))
+                .collect();
+        }
+        self.sightings = self
+            .sightings
+            .iter()
+            .filter_map(|&(station, detection, l)| Some((station, detection, relabel(station, l)?)))
+            .collect();
+        for item in &mut self.held {
+            let station = item.station;
+            item.decided = item
+                .decided
+                .iter()
+                .filter_map(|s| Some(Sighting::new(s.position, relabel(station, s.landmark)?)))
+                .collect();
+        }
     }
 
     /// Maps one station; the record has everything but the decode/detect times.
@@ -891,33 +921,7 @@ impl<C: Calculus> Mapper<C> {
                  and was taken out of it"
             ));
         }
-        for s in &mut self.sighted {
-            let station = s.station;
-            s.frame.landmarks = s
-                .frame
-                .landmarks
-                .iter()
-                .filter_map(|&(l, p)| Some((relabel(station, l)?, p)))
-                .collect();
-            s.bearings = s
-                .bearings
-                .iter()
-                .filter_map(|(&l, &b)| Some((relabel(station, l)?, b)))
-                .collect();
-        }
-        self.sightings = self
-            .sightings
-            .iter()
-            .filter_map(|&(station, detection, l)| Some((station, detection, relabel(station, l)?)))
-            .collect();
-        for item in &mut self.held {
-            let station = item.station;
-            item.decided = item
-                .decided
-                .iter()
-                .filter_map(|s| Some(Sighting::new(s.position, relabel(station, s.landmark)?)))
-                .collect();
-        }
+        self.relabel_fused(relabel);
         if let Some(profile) = self.gallery.profile(landmark).cloned() {
             for &n in &new {
                 self.gallery.profiles.push(Profile {
