@@ -444,6 +444,7 @@ fn stalled_stations_of_a_random_survey_are_revisited_soundly() {
         count("held_back"),
         count("resolved_held_back")
             + count("recognised_held_back")
+            + count("recognised_at_end")
             + count("revisited_held_back")
             + count("expired_held_back")
             + count("pending_held_back"),

@@ -58,7 +58,7 @@ use gallery::chromaticity_distance;
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
 pub use placement::Placed;
 pub use recency::LastSeen;
-pub use recognition::Recognition;
+pub use recognition::{unmapped_rocks_named, Recognition};
 pub use registration::{displacement, register, Frame, Registration, Tracked};
 use registration::{ANCHOR_RADIUS_M, LONG_ANCHOR_RADIUS_M, MIN_INLIERS, SIGNIFICANT_NFA};
 pub use sketch::Sketch;
@@ -913,13 +913,43 @@ fn proposals(
     gallery: &Gallery,
     settings: &AssociationSettings,
 ) -> Vec<(LandmarkId, f64)> {
-    within_gate(gallery, settings, |p| {
-        let width_agrees = match (p.width, evidence.width) {
-            (Some(a), Some(b)) => a.intersection(b).is_some(),
-            _ => true,
-        };
-        width_agrees.then(|| distance(&evidence.appearance, &p.appearance, &settings.scales))
-    })
+    within_gate(gallery, settings, |p| resemblance(evidence, p, settings))
+}
+
+/// The looks distance of a detection from a landmark's profile, unless their widths disagree.
+fn resemblance(evidence: &Evidence, p: &Profile, settings: &AssociationSettings) -> Option<f64> {
+    let width_agrees = match (p.width, evidence.width) {
+        (Some(a), Some(b)) => a.intersection(b).is_some(),
+        _ => true,
+    };
+    width_agrees.then(|| distance(&evidence.appearance, &p.appearance, &settings.scales))
+}
+
+/// The landmarks the gallery proposes for a detection with `evidence` ([`proposals`]).
+pub fn look_alikes(
+    evidence: &Evidence,
+    gallery: &Gallery,
+    settings: &AssociationSettings,
+) -> Vec<LandmarkId> {
+    proposals(evidence, gallery, settings)
+        .into_iter()
+        .map(|(l, _)| l)
+        .collect()
+}
+
+/// Whether the gallery would propose `landmark` for a detection with `evidence` ([`proposals`]):
+/// for a detection seen before the landmark was founded, what proposing it then would have
+/// asked.
+pub fn looks_like(
+    evidence: &Evidence,
+    gallery: &Gallery,
+    settings: &AssociationSettings,
+    landmark: LandmarkId,
+) -> bool {
+    gallery
+        .profile(landmark)
+        .and_then(|p| resemblance(evidence, p, settings))
+        .is_some_and(|d| d <= settings.gate)
 }
 
 /// The landmarks whose colour is within the gate of the detection's, whatever their other

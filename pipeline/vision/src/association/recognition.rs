@@ -11,7 +11,9 @@
 //! a landmark ([`Registration::recognised`]).
 
 use super::placement::Placed;
-use super::registration::{Frame, Registration, MIN_INLIERS};
+use super::registration::{
+    unmapped_partner, Frame, Motion, Registration, MIN_INLIERS, SLACK_M, UNIQUE,
+};
 use qrm_core::map::{LandmarkId, Sighting};
 
 /// An unmapped rock of a registered station's frame recognised as a landmark.
@@ -72,6 +74,50 @@ pub fn recognitions(
                         landmark: a.landmark,
                     })
                 })
+        })
+        .collect()
+}
+
+/// The unmapped rocks of station frame `frame` that landmarks of another station's frame
+/// `other` lie on: (index into [`Frame::unmapped`], landmark), for the landmarks `frame` does
+/// not hold. The motion between the two is the one the landmarks both hold agree on
+/// ([`Motion::consensus`], at least [`MIN_INLIERS`]): known identities, not look-alikes, so
+/// no hypothesis is chosen. Each landmark is carried over by the same unambiguous-partner
+/// test a live recognition passes ([`unmapped_partner`]). Run once the drive is over
+/// (`Mapper::finish`), it lets any station that saw a rock speak for a detection of it that
+/// no station recent enough to register against could name.
+pub fn unmapped_rocks_named(frame: &Frame, other: &Frame) -> Vec<(usize, LandmarkId)> {
+    let shared: Vec<(Placed, Placed)> = other
+        .landmarks
+        .iter()
+        .filter_map(|(l, q)| {
+            let (_, p) = frame.landmarks.iter().find(|(m, _)| m == l)?;
+            Some((*q, *p))
+        })
+        .collect();
+    let Some(motion) = Motion::consensus(shared, MIN_INLIERS) else {
+        return Vec::new();
+    };
+    other
+        .landmarks
+        .iter()
+        .filter(|(l, _)| !frame.landmarks.iter().any(|(m, _)| m == l))
+        .filter_map(|(l, q)| {
+            let g = unmapped_partner(&motion, q, frame)?;
+            let rock = &frame.unmapped[g];
+            // Nor may another landmark of `other`, or a rock it left unmapped, lie on the
+            // rock: then it may be that one (colour marsyard s41: a rock 1.4 m from another's
+            // landmark; stress s45: a rock 0.7 m from a landmark, which frames that held it
+            // named it, where other frames saw the rock apart from it, unmapped).
+            let near = UNIQUE * motion.separation(q, rock).distance + SLACK_M;
+            let alone = other
+                .landmarks
+                .iter()
+                .filter(|(m, _)| m != l)
+                .map(|(_, o)| o)
+                .chain(&other.unmapped)
+                .all(|o| motion.separation(o, rock).distance > near);
+            alone.then_some((g, *l))
         })
         .collect()
 }
@@ -156,5 +202,48 @@ mod tests {
         let mut holding = frame();
         holding.landmarks.push((9, Placed::disc([-6.0, -3.0], 0.3)));
         assert_eq!(recognised(&[holding], &[], false), []);
+    }
+
+    /// Another station's frame, 2 m further along x: FIELD's first four rocks as landmarks
+    /// 0‥3, its fifth as landmark 9, and the `extra` landmarks and `unmapped` rocks.
+    fn other_frame(extra: &[(LandmarkId, [f64; 2])], unmapped: &[[f64; 2]]) -> Frame {
+        let seen = |p: [f64; 2]| Placed::disc([p[0] - 2.0, p[1]], 0.3);
+        Frame {
+            accumulated: false,
+            departed: Vec::new(),
+            tracks: Vec::new(),
+            unmapped: unmapped.iter().map(|&p| seen(p)).collect(),
+            landmarks: (0..4)
+                .map(|k| (k as LandmarkId, seen(FIELD[k])))
+                .chain([(9, seen(FIELD[4]))])
+                .chain(extra.iter().map(|&(l, p)| (l, seen(p))))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn another_frame_names_an_unmapped_rock_by_the_shared_landmarks_motion() {
+        assert_eq!(
+            unmapped_rocks_named(&frame(), &other_frame(&[], &[])),
+            [(0, 9)]
+        );
+    }
+
+    /// A second landmark, or a rock the other station left unmapped, where the rock lies may
+    /// be it; and fewer shared landmarks than a registration needs fix no motion.
+    #[test]
+    fn a_rival_on_the_rock_or_too_few_shared_landmarks_name_nothing() {
+        let beside = [8.15, 8.1];
+        assert_eq!(
+            unmapped_rocks_named(&frame(), &other_frame(&[(7, beside)], &[])),
+            []
+        );
+        assert_eq!(
+            unmapped_rocks_named(&frame(), &other_frame(&[], &[beside])),
+            []
+        );
+        let mut sparse = other_frame(&[], &[]);
+        sparse.landmarks.retain(|(l, _)| *l >= 1);
+        assert_eq!(unmapped_rocks_named(&frame(), &sparse), []);
     }
 }

@@ -81,7 +81,7 @@ pub struct Registration {
 /// Slack added to every distance comparison, metres (rock reference points are not points).
 pub(super) const SLACK_M: f64 = 0.3;
 /// A partner is unambiguous when every rival lies this many times farther (plus the slack).
-const UNIQUE: f64 = 2.0;
+pub(super) const UNIQUE: f64 = 2.0;
 /// How much better (in fit score) the best motion must be than any different one.
 const MARGIN: f64 = 1.5;
 /// Loosest placement of a detection that anchors on the usual terms, metres: a looser one (a far

@@ -10,8 +10,9 @@ use super::record::{
 use super::selection;
 use crate::association::audit::{regroup, Regrouping};
 use crate::association::{
-    agreement, associate, reconsider, sketch, unfounded, AssociationSettings, Decision, Evidence,
-    Frame, Gallery, LastSeen, Placed, Profile, Recognition, Sketch, StationEvidence,
+    agreement, associate, look_alikes, looks_like, reconsider, sketch, unfounded,
+    unmapped_rocks_named, AssociationSettings, Decision, Evidence, Frame, Gallery, LastSeen,
+    Placed, Profile, Recognition, Sketch, StationEvidence, Unfounded,
 };
 use crate::calib::Calibration;
 use crate::detection::{Detection, Separation};
@@ -20,6 +21,7 @@ use qrm_core::calculus::Calculus;
 use qrm_core::map::{Hypergraph, Journal, LandmarkId, Sighting};
 use qrm_core::measurement::{Bearing, StationView};
 use qrm_core::neighborhood::{estimate, RngEstimate};
+use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
 use std::time::Instant;
@@ -94,6 +96,13 @@ struct HeldBack {
     /// The landmark each later station that recognised it recognised it as (a station's
     /// frame is registered once, so it recognises an observation once at most).
     recognised: Vec<LandmarkId>,
+    /// The map's next landmark id once its station was fused: landmarks from this one on
+    /// were founded later, and were never offered to it as candidates.
+    founded_after: LandmarkId,
+    /// A detection that matched no landmark and founded none (a piece or a doubted one,
+    /// [`Unfounded`]), recorded unused: not held back, only named at the end of the drive
+    /// ([`Mapper::recognise_given_up`]).
+    withheld: bool,
 }
 
 /// A station whose detections registered against no frame and were all held back, then
@@ -134,6 +143,13 @@ pub struct Mapper<C: Calculus> {
     sensor: SensorModel,
     association: AssociationSettings,
     held: Vec<HeldBack>,
+    /// Observations that waited out [`RECENT_FRAMES`] unfused, measurable with their
+    /// station's other sightings: named, if the drive's frames agree, when it is over
+    /// ([`Mapper::recognise_given_up`]).
+    given_up: Vec<HeldBack>,
+    /// Observations [`Mapper::finish`] fused as the landmark every other station's frame
+    /// put on them.
+    pub recognised_at_end: Vec<LateSighting>,
     /// The recently seen landmarks placed in one coordinate system.
     sketch: Sketch,
     /// When each landmark was last fused.
@@ -169,6 +185,8 @@ impl<C: Calculus> Mapper<C> {
             sensor,
             association,
             held: Vec::new(),
+            given_up: Vec::new(),
+            recognised_at_end: Vec::new(),
             sketch: Sketch::default(),
             last_seen: LastSeen::default(),
             sighted: Vec::new(),
@@ -221,6 +239,7 @@ impl<C: Calculus> Mapper<C> {
     /// landmark derived them from its own station's measurement, which the rock or ground
     /// point it saw satisfies.
     pub fn finish(&mut self) -> MetricsRecord {
+        self.recognise_given_up();
         let mut stations: BTreeMap<LandmarkId, BTreeSet<usize>> = BTreeMap::new();
         for &(station, _, l) in &self.sightings {
             stations.entry(l).or_default().insert(station);
@@ -267,7 +286,7 @@ impl<C: Calculus> Mapper<C> {
             .iter()
             .filter_map(|&(station, detection, l)| Some((station, detection, relabel(station, l)?)))
             .collect();
-        for item in &mut self.held {
+        for item in self.held.iter_mut().chain(&mut self.given_up) {
             let station = item.station;
             item.decided = item
                 .decided
@@ -755,6 +774,149 @@ impl<C: Calculus> Mapper<C> {
         self.held = held;
     }
 
+    /// Names the observations given up during the drive, and those still held, once it is
+    /// over: an observation is fused as the landmark that the frames of [`RECOGNITIONS`] or
+    /// more other stations put on it, each by the motion their shared landmarks agree on and
+    /// the unambiguous-partner test of a live recognition
+    /// ([`crate::association::unmapped_rocks_named`]), when no frame names another, it may
+    /// have been that landmark ([`Mapper::may_have_been`]), it is not flat, and the map does
+    /// not reject it ([`Mapper::allows`]). A live recognition needs a later station within
+    /// [`RECENT_FRAMES`] that anchors the rock; a rock founded later, or seen again only
+    /// after the rover came back, never had one (colour marsyard s31: of 56 pieces of mapped
+    /// rocks left unused, 42 were of rocks founded after them, 23 with no station anchoring
+    /// it within the window; stop 76, docs/RUN.md).
+    fn recognise_given_up(&mut self) {
+        let given_up = std::mem::take(&mut self.given_up);
+        let pending = std::mem::take(&mut self.held);
+        let names = self.frames_naming(given_up.iter().chain(&pending));
+        let mut items: Vec<(HeldBack, bool)> = given_up
+            .into_iter()
+            .map(|item| (item, true))
+            .chain(pending.into_iter().map(|item| (item, false)))
+            .collect();
+        let mut fused = vec![false; items.len()];
+        for k in 0..items.len() {
+            let item = &items[k].0;
+            let Some(landmark) = names[k].filter(|&l| {
+                !item.evidence.flat
+                    && !item.decided.iter().any(|d| d.landmark == l)
+                    && self.may_have_been(item, l)
+                    && self.allows(item, l)
+            }) else {
+                continue;
+            };
+            let item = item.clone();
+            if self.fuse_held(&item, landmark, &mut []).is_err() {
+                continue;
+            }
+            let sighting = Sighting::new(item.detection, landmark);
+            for (other, _) in items
+                .iter_mut()
+                .filter(|(o, _)| o.station == item.station && o.detection != item.detection)
+            {
+                other.decided.push(sighting);
+            }
+            // Held back and given up before, it is now recognised instead.
+            if items[k].1 && !item.withheld {
+                self.expired -= 1;
+            }
+            fused[k] = true;
+            self.recognised_at_end.push(LateSighting {
+                station: item.station,
+                detection: item.primary_index,
+                landmark,
+            });
+        }
+        for ((item, given_up), fused) in items.into_iter().zip(fused) {
+            match (fused, given_up) {
+                (true, _) => {}
+                (false, true) => self.given_up.push(item),
+                (false, false) => self.held.push(item),
+            }
+        }
+    }
+
+    /// For each of `items`, the landmark that the frames of [`RECOGNITIONS`] or more other
+    /// stations put on it ([`crate::association::unmapped_rocks_named`]), if none puts
+    /// another, and each of its rivals (its candidates and the landmarks it looks like,
+    /// [`look_alikes`]) is fused at its station or held by a naming frame, which places it
+    /// elsewhere. A rival none of them holds may be the rock (colour marsyard s41: a blob of
+    /// two rocks 1.4 m apart named as the one whose landmark the naming frames held).
+    fn frames_naming<'a>(
+        &self,
+        items: impl Iterator<Item = &'a HeldBack> + Clone,
+    ) -> Vec<Option<LandmarkId>> {
+        let stations: BTreeSet<usize> = items.clone().map(|item| item.station).collect();
+        // (station, unmapped rock of its frame) → the landmarks other frames put on it, and
+        // every landmark those frames hold.
+        let mut named: BTreeMap<(usize, usize), (Vec<LandmarkId>, BTreeSet<LandmarkId>)> =
+            BTreeMap::new();
+        for sighted in self
+            .sighted
+            .iter()
+            .filter(|s| stations.contains(&s.station))
+        {
+            let found: Vec<(&Frame, Vec<(usize, LandmarkId)>)> = self
+                .sighted
+                .par_iter()
+                .filter(|other| other.station != sighted.station)
+                .map(|other| {
+                    let names = unmapped_rocks_named(&sighted.frame, &other.frame);
+                    (&other.frame, names)
+                })
+                .collect();
+            for (other, names) in found {
+                for (g, l) in names {
+                    let entry = named.entry((sighted.station, g)).or_default();
+                    entry.0.push(l);
+                    entry.1.extend(other.landmarks.iter().map(|m| m.0));
+                }
+            }
+        }
+        items
+            .map(|item| {
+                let sighted = self.sighted.iter().find(|s| s.station == item.station)?;
+                let placed = item.evidence.placed?;
+                let g = sighted.frame.unmapped.iter().position(|&u| u == placed)?;
+                let (names, held) = named.get(&(item.station, g))?;
+                let l = names[0];
+                let accounted = |r: LandmarkId| {
+                    r == l || held.contains(&r) || item.decided.iter().any(|d| d.landmark == r)
+                };
+                let rivals_accounted = item.candidates.iter().all(|&r| accounted(r))
+                    && look_alikes(&item.evidence, &self.gallery, &self.association)
+                        .into_iter()
+                        .all(accounted);
+                (names.len() >= RECOGNITIONS && names.iter().all(|&m| m == l) && rivals_accounted)
+                    .then_some(l)
+            })
+            .collect()
+    }
+
+    /// Whether observation `item` may be `landmark`: one of its candidates, or one founded
+    /// after its station, never offered to it, whose looks it shares. (A piece left unused is
+    /// mostly of a rock whose landmark a whole view of it founded later: colour marsyard s31,
+    /// 42 of 56 pieces of mapped rocks; stop 76, docs/RUN.md.)
+    fn may_have_been(&self, item: &HeldBack, landmark: LandmarkId) -> bool {
+        item.candidates.contains(&landmark)
+            || (landmark >= item.founded_after
+                && looks_like(&item.evidence, &self.gallery, &self.association, landmark))
+    }
+
+    /// Whether the map, as it now stands, does not reject held-back observation `item` as
+    /// `landmark` (000 §VI-C's test, which its candidates passed when it was held back).
+    fn allows(&self, item: &HeldBack, landmark: LandmarkId) -> bool {
+        reconsider(
+            &self.map,
+            &item.view,
+            item.detection,
+            &[landmark],
+            &item.decided,
+            &self.association,
+        )
+        .is_some_and(|left| left.contains(&landmark))
+    }
+
     /// Fuses held-back observation `item` as `landmark`: its triples with the station's fused
     /// detections, its looks, its sighting, and its place in the station's frame. The
     /// station's other `held` observations gain it as a partner to measure with.
@@ -798,6 +960,7 @@ impl<C: Calculus> Mapper<C> {
         }
         for other in held
             .iter_mut()
+            .chain(&mut self.given_up)
             .filter(|o| o.station == item.station && o.detection != item.detection)
         {
             other.decided.push(sighting);
@@ -982,6 +1145,22 @@ impl<C: Calculus> Mapper<C> {
                 decided: associated.fused.clone(),
                 evidence: associated.evidence[position].clone(),
                 recognised: Vec::new(),
+                founded_after: associated.next_landmark,
+                withheld: false,
+            });
+        }
+        for position in associated.withheld {
+            self.given_up.push(HeldBack {
+                station: record.index,
+                view: Arc::clone(&view),
+                detection: position,
+                primary_index: associated.usable[position],
+                candidates: Vec::new(),
+                decided: associated.fused.clone(),
+                evidence: associated.evidence[position].clone(),
+                recognised: Vec::new(),
+                founded_after: associated.next_landmark,
+                withheld: true,
             });
         }
     }
@@ -992,12 +1171,18 @@ impl<C: Calculus> Mapper<C> {
     /// recent ones ([`Mapper::fuse_recognised`]).
     fn retry_held_back(&mut self, record: &mut StationRecord) -> usize {
         let current = record.index;
-        let mut pending = std::mem::take(&mut self.held);
-        let before = pending.len();
         // Observations whose station's frame is no longer registered against, or that have
-        // too few fused partners at their station to be measured with, are given up.
-        pending.retain(|item| current < item.station + RECENT_FRAMES && item.decided.len() >= 2);
-        self.expired += before - pending.len();
+        // too few fused partners at their station to be measured with, are given up; the
+        // measurable ones wait for the end of the drive ([`Mapper::recognise_given_up`]).
+        let (mut pending, out): (Vec<HeldBack>, Vec<HeldBack>) = std::mem::take(&mut self.held)
+            .into_iter()
+            .partition(|item| current < item.station + RECENT_FRAMES && item.decided.len() >= 2);
+        for item in out {
+            self.expired += 1;
+            if item.decided.len() >= 2 && item.evidence.placed.is_some() {
+                self.given_up.push(item);
+            }
+        }
         let mut resolved = 0;
         let mut done = vec![false; pending.len()];
         for k in 0..pending.len() {
@@ -1159,6 +1344,9 @@ struct Associated {
     decisions: Vec<Decision>,
     fused: Vec<Sighting>,
     held: Vec<(usize, Vec<LandmarkId>)>,
+    /// Placed detections that matched no landmark and founded none for being a piece or
+    /// doubted: they wait for the end of the drive ([`HeldBack::withheld`]).
+    withheld: Vec<usize>,
     /// The map's next landmark id once the new ones are fused.
     next_landmark: LandmarkId,
 }
@@ -1197,6 +1385,7 @@ impl Associated {
     ) -> Associated {
         let mut fused = Vec::new();
         let mut held = Vec::new();
+        let mut withheld = Vec::new();
         for (position, decision) in decisions.iter().enumerate() {
             match decision {
                 Decision::Matched(l) => fused.push(Sighting::new(position, *l)),
@@ -1205,6 +1394,11 @@ impl Associated {
                     next_landmark += 1;
                 }
                 Decision::HeldBack(candidates) => held.push((position, candidates.clone())),
+                Decision::Withheld(Unfounded::Piece | Unfounded::Doubtful)
+                    if station.detections[position].placed.is_some() =>
+                {
+                    withheld.push(position)
+                }
                 Decision::Withheld(_) => {}
             }
         }
@@ -1215,6 +1409,7 @@ impl Associated {
             decisions,
             fused,
             held,
+            withheld,
             next_landmark,
         }
     }
@@ -1368,6 +1563,8 @@ mod tests {
                 pixels: 100,
             },
             recognised: Vec::new(),
+            founded_after: LandmarkId::MAX,
+            withheld: false,
         });
         seen.placed[k]
     }
@@ -1455,6 +1652,114 @@ mod tests {
     fn recognitions_as_different_landmarks_fuse_nothing() {
         assert_stays_held(false, 15, 3);
         assert_stays_held(false, 15, 7);
+    }
+
+    /// The observation of rock 15 held at station 2 with `candidates`, given up, its looks
+    /// unlike every landmark's (its candidates are its only rivals), and stations 3 and 4
+    /// fused after it; returns its position in station 2's view.
+    fn given_up_at_station_2(mapper: &mut Mapper<Edc>, candidates: Vec<LandmarkId>) -> usize {
+        held_at_station_2(mapper);
+        let mut item = mapper.held.pop().expect("held at station 2");
+        item.candidates = candidates;
+        item.evidence.appearance.brightness *= 50.0;
+        let k = item.detection;
+        mapper.given_up.push(item);
+        mapper.expired = 1;
+        for step in 3..5 {
+            fuse_unchecked(mapper, step, &seen(step, STATIONS), |r| r as LandmarkId);
+        }
+        k
+    }
+
+    /// Once the drive is over, the frames of the stations before and after name the given-up
+    /// observation as its rock's landmark, and it is fused as that.
+    #[test]
+    fn a_given_up_observation_named_by_other_frames_is_fused_at_the_end() {
+        let mut mapper = test_mapper();
+        let k = given_up_at_station_2(&mut mapper, vec![15, 3]);
+        mapper.finish();
+        assert_eq!(
+            mapper.recognised_at_end,
+            [LateSighting {
+                station: 2,
+                detection: k,
+                landmark: 15,
+            }]
+        );
+        assert!(mapper.sightings.contains(&(2, k, 15)));
+        assert_eq!(mapper.expired, 0, "no longer given up");
+        assert!(mapper.given_up.is_empty());
+        assert_eq!(unsound(&mapper.map, |l| l as usize), 0);
+    }
+
+    /// A candidate that neither the observation's station fused nor any naming frame holds
+    /// may be its rock: the observation stays given up.
+    #[test]
+    fn a_rival_no_frame_places_keeps_a_given_up_observation_out() {
+        let mut mapper = test_mapper();
+        given_up_at_station_2(&mut mapper, vec![15, 99]);
+        mapper.finish();
+        assert!(mapper.recognised_at_end.is_empty());
+        assert_eq!(mapper.given_up.len(), 1);
+        assert_eq!(mapper.expired, 1);
+    }
+
+    /// Rock 15's detection at station 2 as a piece that matched no landmark and founded none,
+    /// seen before landmarks `founded_after` on were founded, and stations 3 and 4 fused after
+    /// it; landmark 15 alone looks like it when `alike`. Returns its position.
+    fn piece_at_station_2(
+        mapper: &mut Mapper<Edc>,
+        founded_after: LandmarkId,
+        alike: bool,
+    ) -> usize {
+        let k = given_up_at_station_2(mapper, Vec::new());
+        mapper.expired = 0;
+        let item = &mut mapper.given_up[0];
+        item.withheld = true;
+        item.evidence.piece = true;
+        item.founded_after = founded_after;
+        if alike {
+            let looks = item.evidence.appearance.clone();
+            let profile = mapper
+                .gallery
+                .profiles
+                .iter_mut()
+                .find(|p| p.landmark == 15);
+            profile.expect("landmark 15's looks").appearance = looks;
+        }
+        k
+    }
+
+    /// A piece named by the other stations' frames as a landmark founded after it, whose
+    /// looks it shares, is fused as that landmark at the end.
+    #[test]
+    fn a_piece_named_as_a_landmark_founded_after_it_is_fused_at_the_end() {
+        let mut mapper = test_mapper();
+        let k = piece_at_station_2(&mut mapper, 10, true);
+        mapper.finish();
+        assert_eq!(
+            mapper.recognised_at_end,
+            [LateSighting {
+                station: 2,
+                detection: k,
+                landmark: 15,
+            }]
+        );
+        assert_eq!(mapper.expired, 0, "a piece was never held back");
+        assert_eq!(unsound(&mapper.map, |l| l as usize), 0);
+    }
+
+    /// Not as a landmark that existed when the piece was seen (association did not take it
+    /// then), nor as one whose looks are not the piece's.
+    #[test]
+    fn a_piece_is_not_named_as_an_older_or_unlike_landmark() {
+        for (founded_after, alike) in [(16, true), (10, false)] {
+            let mut mapper = test_mapper();
+            piece_at_station_2(&mut mapper, founded_after, alike);
+            mapper.finish();
+            assert!(mapper.recognised_at_end.is_empty());
+            assert_eq!(mapper.given_up.len(), 1);
+        }
     }
 
     #[test]

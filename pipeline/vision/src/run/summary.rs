@@ -1,7 +1,7 @@
 //! The few numbers a user wants at the end of `pipeline run` (also `summary.json`).
 
 use super::mapper::Mapper;
-use super::record::{Association, MetricsRecord, StationRecord};
+use super::record::{Association, LateSighting, MetricsRecord, StationRecord};
 use crate::detection::Channels;
 use qrm_core::calculus::Calculus;
 use serde::{Deserialize, Serialize};
@@ -34,13 +34,19 @@ pub struct RunSummary {
     #[serde(default)]
     pub landmarks_split: usize,
     /// Observations held back at their station, resolved later (re-tested on a tighter map,
-    /// or recognised at later stations: `association::recognition`), and still pending at the
-    /// end.
+    /// recognised at later stations: `association::recognition`, or named by the drive's
+    /// frames once it was over: `Mapper::finish`), and still pending at the end.
     pub held_back: usize,
     pub resolved_held_back: usize,
     #[serde(default)]
     pub recognised_held_back: usize,
+    #[serde(default)]
+    pub recognised_at_end: usize,
     pub pending_held_back: usize,
+    /// Detections recorded unused for founding no landmark (pieces, doubted) and named at the
+    /// end of the drive as a landmark founded after them.
+    #[serde(default)]
+    pub recognised_unused: usize,
     /// Held back at a stalled station (one whose detections registered against nothing) and
     /// fused when a later station's frames let it be mapped again (`Mapper::revisit_stalled`).
     #[serde(default)]
@@ -113,6 +119,12 @@ impl RunSummary {
     ) -> RunSummary {
         let sum = |f: fn(&StationRecord) -> f64| records.iter().map(f).sum::<f64>();
         let revisited = || records.iter().flat_map(|r| &r.fusion.revisited);
+        let held_back_at = |l: &LateSighting| {
+            matches!(
+                records[l.station].detections[l.detection].association,
+                Association::HeldBack { .. }
+            )
+        };
         RunSummary {
             stations: records.len(),
             stations_skipped: skipped,
@@ -139,15 +151,18 @@ impl RunSummary {
                 .count(),
             resolved_held_back: records.iter().map(|r| r.fusion.resolved_held_back).sum(),
             recognised_held_back: records.iter().map(|r| r.fusion.recognised.len()).sum(),
-            pending_held_back: mapper.held_back(),
-            revisited_held_back: revisited()
-                .filter(|l| {
-                    matches!(
-                        records[l.station].detections[l.detection].association,
-                        Association::HeldBack { .. }
-                    )
-                })
+            recognised_at_end: mapper
+                .recognised_at_end
+                .iter()
+                .filter(|l| held_back_at(l))
                 .count(),
+            pending_held_back: mapper.held_back(),
+            recognised_unused: mapper
+                .recognised_at_end
+                .iter()
+                .filter(|l| !held_back_at(l))
+                .count(),
+            revisited_held_back: revisited().filter(|l| held_back_at(l)).count(),
             stations_revisited: {
                 let mut stations: Vec<usize> = revisited().map(|l| l.station).collect();
                 stations.sort_unstable();
@@ -221,16 +236,24 @@ impl fmt::Display for RunSummary {
         )?;
         writeln!(
             f,
-            "contradictions: {}; landmarks split: {}; held back: {} ({} resolved by re-test, {} recognised at later stations, {} fused when their station was revisited, {} given up, {} pending)",
+            "contradictions: {}; landmarks split: {}; held back: {} ({} resolved by re-test, {} recognised at later stations, {} named by the drive's frames at its end, {} fused when their station was revisited, {} given up, {} pending)",
             self.contradictions,
             self.landmarks_split,
             self.held_back,
             self.resolved_held_back,
             self.recognised_held_back,
+            self.recognised_at_end,
             self.revisited_held_back,
             self.expired_held_back,
             self.pending_held_back
         )?;
+        if self.recognised_unused > 0 {
+            writeln!(
+                f,
+                "pieces and doubted detections (recorded unused) named at the end as landmarks founded after them: {}",
+                self.recognised_unused
+            )?;
+        }
         if self.stations_revisited > 0 {
             writeln!(
                 f,
