@@ -232,7 +232,7 @@ impl<C: Calculus> Mapper<C> {
     /// mostly no rock but a blob of ground or shadow the stereo test could not call flat: on
     /// the ten colour marsyard seeds, 21 landmarks were fused from one station only and none
     /// was a rock (s17, s19 and s29: 4–5 each); on all 27 sets of stop 75's figures, 13 of 59
-    /// were, 5 of them second landmarks of rocks mapped already (docs/RUN.md, stage 8). Each
+    /// were, 5 of them second landmarks of rocks mapped already (docs/RUN.md, stage 9). Each
     /// such landmark is a node of the RNG no later station can find, and its triples with
     /// every other landmark have no true state. Leaving it out loses no soundness: the
     /// relations kept are those the map holds, and path consistency through the dropped
@@ -782,9 +782,9 @@ impl<C: Calculus> Mapper<C> {
     /// have been that landmark ([`Mapper::may_have_been`]), it is not flat, and the map does
     /// not reject it ([`Mapper::allows`]). A live recognition needs a later station within
     /// [`RECENT_FRAMES`] that anchors the rock; a rock founded later, or seen again only
-    /// after the rover came back, never had one (colour marsyard s31: of 56 pieces of mapped
-    /// rocks left unused, 42 were of rocks founded after them, 23 with no station anchoring
-    /// it within the window; stop 76, docs/RUN.md).
+    /// after the rover came back, never had one (colour marsyard s31 at stop 75: of 60 pieces of
+    /// mapped rocks left unused, 55 were of rocks founded 1–20 stations after them, 19 with no
+    /// station anchoring it within the window; stop 76, docs/RUN.md).
     fn recognise_given_up(&mut self) {
         let given_up = std::mem::take(&mut self.given_up);
         let pending = std::mem::take(&mut self.held);
@@ -896,7 +896,7 @@ impl<C: Calculus> Mapper<C> {
     /// Whether observation `item` may be `landmark`: one of its candidates, or one founded
     /// after its station, never offered to it, whose looks it shares. (A piece left unused is
     /// mostly of a rock whose landmark a whole view of it founded later: colour marsyard s31,
-    /// 42 of 56 pieces of mapped rocks; stop 76, docs/RUN.md.)
+    /// 55 of 60 pieces of mapped rocks; stop 76, docs/RUN.md.)
     fn may_have_been(&self, item: &HeldBack, landmark: LandmarkId) -> bool {
         item.candidates.contains(&landmark)
             || (landmark >= item.founded_after
