@@ -147,8 +147,8 @@ pub struct Mapper<C: Calculus> {
     /// station's other sightings: named, if the drive's frames agree, when it is over
     /// ([`Mapper::recognise_given_up`]).
     given_up: Vec<HeldBack>,
-    /// Observations [`Mapper::finish`] fused as the landmark every other station's frame
-    /// put on them.
+    /// Observations [`Mapper::finish`] fused as the landmark other stations' frames put on
+    /// them ([`Mapper::recognise_given_up`]).
     pub recognised_at_end: Vec<LateSighting>,
     /// The recently seen landmarks placed in one coordinate system.
     sketch: Sketch,
@@ -1149,7 +1149,9 @@ impl<C: Calculus> Mapper<C> {
                 withheld: false,
             });
         }
-        for position in associated.withheld {
+        // Without two fused partners at its station it could not be measured.
+        let measurable = associated.fused.len() >= 2;
+        for position in associated.withheld.into_iter().filter(|_| measurable) {
             self.given_up.push(HeldBack {
                 station: record.index,
                 view: Arc::clone(&view),
