@@ -818,7 +818,8 @@ impl<C: Calculus> Mapper<C> {
             }
             // Held back and given up before, it is now recognised instead.
             if items[k].1 && !item.withheld {
-                self.expired -= 1;
+                debug_assert!(self.expired > 0, "a given-up observation was counted");
+                self.expired = self.expired.saturating_sub(1);
             }
             fused[k] = true;
             self.recognised_at_end.push(LateSighting {
