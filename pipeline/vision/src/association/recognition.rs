@@ -12,7 +12,7 @@
 
 use super::placement::Placed;
 use super::registration::{
-    unmapped_partner, Frame, Motion, Registration, MIN_INLIERS, SLACK_M, UNIQUE,
+    shared_placements, unmapped_partner, Frame, Motion, Registration, MIN_INLIERS, SLACK_M, UNIQUE,
 };
 use qrm_core::map::{LandmarkId, Sighting};
 
@@ -87,15 +87,7 @@ pub fn recognitions(
 /// (`Mapper::finish`), it lets any station that saw a rock speak for a detection of it that
 /// no station recent enough to register against could name.
 pub fn unmapped_rocks_named(frame: &Frame, other: &Frame) -> Vec<(usize, LandmarkId)> {
-    let shared: Vec<(Placed, Placed)> = other
-        .landmarks
-        .iter()
-        .filter_map(|(l, q)| {
-            let (_, p) = frame.landmarks.iter().find(|(m, _)| m == l)?;
-            Some((*q, *p))
-        })
-        .collect();
-    let Some(motion) = Motion::consensus(shared, MIN_INLIERS) else {
+    let Some(motion) = Motion::consensus(shared_placements(other, frame), MIN_INLIERS) else {
         return Vec::new();
     };
     other

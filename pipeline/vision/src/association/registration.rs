@@ -931,14 +931,7 @@ fn unaccounted(motion: &Motion, p: &Placed, g: &Placed, others: &[Placed]) -> bo
 /// `sparse-large` seed 3, the demo), errors over this s.d. had an r.m.s. of 0.85–0.96 while
 /// placements were discs fitted on their points alone (not measured since).
 pub fn displacement(earlier: &Frame, later: &Frame) -> Option<(f64, f64)> {
-    let pairs: Vec<(Placed, Placed)> = later
-        .landmarks
-        .iter()
-        .filter_map(|(l, p)| {
-            let (_, q) = earlier.landmarks.iter().find(|(m, _)| m == l)?;
-            Some((*p, *q))
-        })
-        .collect();
+    let pairs = shared_placements(later, earlier);
     let motion = Motion::consensus(pairs.clone(), MIN_INLIERS)?;
     let agreeing: Vec<&(Placed, Placed)> = pairs
         .iter()
@@ -963,6 +956,18 @@ pub fn displacement(earlier: &Frame, later: &Frame) -> Option<(f64, f64)> {
     let [x, y] = motion.shift;
     let moved = x.hypot(y);
     (moved >= 2.0 * shift_sd).then(|| (y.atan2(x), shift_sd.atan2(moved)))
+}
+
+/// The landmarks both frames hold, each as its placement in `from` and in `onto`: the pairs a
+/// motion from one frame's coordinates to the other's is fitted on ([`Motion::consensus`]).
+pub(super) fn shared_placements(from: &Frame, onto: &Frame) -> Vec<(Placed, Placed)> {
+    from.landmarks
+        .iter()
+        .filter_map(|(l, p)| {
+            let (_, q) = onto.landmarks.iter().find(|(m, _)| m == l)?;
+            Some((*p, *q))
+        })
+        .collect()
 }
 
 /// How far `motion` leaves `p` beyond the placements of `p` and `q` and the slack (a

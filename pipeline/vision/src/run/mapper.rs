@@ -1132,39 +1132,31 @@ impl<C: Calculus> Mapper<C> {
         associated: Associated,
         view: Arc<StationView>,
     ) {
-        for (position, candidates) in associated.held {
-            let primary_index = associated.usable[position];
-            record.detections[primary_index].association = Association::HeldBack {
+        let station = record.index;
+        let observation = |position: usize, candidates: Vec<LandmarkId>, withheld: bool| HeldBack {
+            station,
+            view: Arc::clone(&view),
+            detection: position,
+            primary_index: associated.usable[position],
+            candidates,
+            decided: associated.fused.clone(),
+            evidence: associated.evidence[position].clone(),
+            recognised: Vec::new(),
+            founded_after: associated.next_landmark,
+            withheld,
+        };
+        for (position, candidates) in &associated.held {
+            record.detections[associated.usable[*position]].association = Association::HeldBack {
                 candidates: candidates.clone(),
             };
-            self.held.push(HeldBack {
-                station: record.index,
-                view: Arc::clone(&view),
-                detection: position,
-                primary_index,
-                candidates,
-                decided: associated.fused.clone(),
-                evidence: associated.evidence[position].clone(),
-                recognised: Vec::new(),
-                founded_after: associated.next_landmark,
-                withheld: false,
-            });
+            self.held
+                .push(observation(*position, candidates.clone(), false));
         }
         // Without two fused partners at its station it could not be measured.
-        let measurable = associated.fused.len() >= 2;
-        for position in associated.withheld.into_iter().filter(|_| measurable) {
-            self.given_up.push(HeldBack {
-                station: record.index,
-                view: Arc::clone(&view),
-                detection: position,
-                primary_index: associated.usable[position],
-                candidates: Vec::new(),
-                decided: associated.fused.clone(),
-                evidence: associated.evidence[position].clone(),
-                recognised: Vec::new(),
-                founded_after: associated.next_landmark,
-                withheld: true,
-            });
+        if associated.fused.len() >= 2 {
+            for &position in &associated.withheld {
+                self.given_up.push(observation(position, Vec::new(), true));
+            }
         }
     }
 
@@ -1674,13 +1666,9 @@ mod tests {
         k
     }
 
-    /// Once the drive is over, the frames of the stations before and after name the given-up
-    /// observation as its rock's landmark, and it is fused as that.
-    #[test]
-    fn a_given_up_observation_named_by_other_frames_is_fused_at_the_end() {
-        let mut mapper = test_mapper();
-        let k = given_up_at_station_2(&mut mapper, vec![15, 3]);
-        mapper.finish();
+    /// The end of the drive fused station 2's detection at position `k`, and only that, as
+    /// landmark 15.
+    fn assert_named_15_at_end(mapper: &Mapper<Edc>, k: usize) {
         assert_eq!(
             mapper.recognised_at_end,
             [LateSighting {
@@ -1689,6 +1677,16 @@ mod tests {
                 landmark: 15,
             }]
         );
+    }
+
+    /// Once the drive is over, the frames of the stations before and after name the given-up
+    /// observation as its rock's landmark, and it is fused as that.
+    #[test]
+    fn a_given_up_observation_named_by_other_frames_is_fused_at_the_end() {
+        let mut mapper = test_mapper();
+        let k = given_up_at_station_2(&mut mapper, vec![15, 3]);
+        mapper.finish();
+        assert_named_15_at_end(&mapper, k);
         assert!(mapper.sightings.contains(&(2, k, 15)));
         assert_eq!(mapper.expired, 0, "no longer given up");
         assert!(mapper.given_up.is_empty());
@@ -1740,14 +1738,7 @@ mod tests {
         let mut mapper = test_mapper();
         let k = piece_at_station_2(&mut mapper, 10, true);
         mapper.finish();
-        assert_eq!(
-            mapper.recognised_at_end,
-            [LateSighting {
-                station: 2,
-                detection: k,
-                landmark: 15,
-            }]
-        );
+        assert_named_15_at_end(&mapper, k);
         assert_eq!(mapper.expired, 0, "a piece was never held back");
         assert_eq!(unsound(&mapper.map, |l| l as usize), 0);
     }
