@@ -1180,19 +1180,29 @@ impl Motion {
                 .collect()
         };
         let count = |agree: &[bool]| agree.iter().filter(|&&a| a).count();
-        let best = (0..pairs.len())
+        let hypothesis = |(a, b): (usize, usize)| {
+            Motion::from_pairs(
+                [pairs[a].0.point, pairs[b].0.point],
+                [pairs[a].1.point, pairs[b].1.point],
+            )
+        };
+        // Hypotheses are counted without keeping their verdicts; of equal counts the last wins.
+        let (_, chosen) = (0..pairs.len())
             .flat_map(|a| {
                 (0..pairs.len())
                     .filter(move |&b| b != a)
                     .map(move |b| (a, b))
             })
-            .map(|(a, b)| {
-                agreeing(&Motion::from_pairs(
-                    [pairs[a].0.point, pairs[b].0.point],
-                    [pairs[a].1.point, pairs[b].1.point],
-                ))
+            .map(|pair| {
+                let motion = hypothesis(pair);
+                let agreeing = grown
+                    .iter()
+                    .filter(|g| g.separation(&motion).within())
+                    .count();
+                (agreeing, pair)
             })
-            .max_by_key(|agree| count(agree))?;
+            .max_by_key(|&(agreeing, _)| agreeing)?;
+        let best = agreeing(&hypothesis(chosen));
         if count(&best) < fewest {
             return None;
         }

@@ -600,11 +600,17 @@ impl<C: Calculus> Mapper<C> {
         // audit then retired 21 stations' sightings of one). Its matches must agree with
         // every station's placements before anything of it is fused.
         let frame = decided.associated.frame();
-        let disputed = frame.landmarks.iter().any(|&(l, _)| {
-            self.sighted.iter().any(|s| {
-                s.station != stalled.index && agreement::witness(&s.frame, &frame, l) == Some(false)
-            })
-        });
+        let disputed = self
+            .sighted
+            .iter()
+            .filter(|s| s.station != stalled.index)
+            .map(|s| agreement::Witness::new(&s.frame, &frame))
+            .any(|witness| {
+                frame
+                    .landmarks
+                    .iter()
+                    .any(|&(l, _)| witness.of(l) == Some(false))
+            });
         if disputed {
             return None;
         }
@@ -1023,17 +1029,18 @@ impl<C: Calculus> Mapper<C> {
         let Some(current) = self.sighted.iter().find(|s| s.station == record.index) else {
             return;
         };
+        let witnesses: Vec<agreement::Witness> = self
+            .sighted
+            .iter()
+            .filter(|s| s.station != record.index)
+            .map(|s| agreement::Witness::new(&s.frame, &current.frame))
+            .collect();
         let contradicted: Vec<LandmarkId> = current
             .frame
             .landmarks
             .iter()
             .map(|m| m.0)
-            .filter(|&l| {
-                self.sighted
-                    .iter()
-                    .filter(|s| s.station != record.index)
-                    .any(|s| agreement::witness(&s.frame, &current.frame, l) == Some(false))
-            })
+            .filter(|&l| witnesses.iter().any(|w| w.of(l) == Some(false)))
             .collect();
         for landmark in contradicted {
             let sightings: Vec<(usize, &Frame)> = self
