@@ -44,6 +44,7 @@
 pub mod agreement;
 pub mod audit;
 mod disc_grid;
+pub mod duplicate;
 mod gallery;
 mod placement;
 mod recency;

@@ -243,6 +243,17 @@ pub struct SplitRecord {
     pub retired: Vec<usize>,
 }
 
+/// Two landmarks found to be one rock once the drive was over (`association::duplicate`): the
+/// sightings of `duplicate` joined `landmark`, from `frame_pairs` pairs of stations whose
+/// frames put the two on each other. `landmarks.json` has the sightings as merged; a station's
+/// record keeps the decision made when it was mapped.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MergeRecord {
+    pub landmark: LandmarkId,
+    pub duplicate: LandmarkId,
+    pub frame_pairs: usize,
+}
+
 /// The map after a panorama.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MetricsRecord {

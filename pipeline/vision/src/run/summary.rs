@@ -1,7 +1,7 @@
 //! The few numbers a user wants at the end of `pipeline run` (also `summary.json`).
 
 use super::mapper::Mapper;
-use super::record::{Association, LateSighting, MetricsRecord, StationRecord};
+use super::record::{Association, LateSighting, MergeRecord, MetricsRecord, StationRecord};
 use crate::detection::Channels;
 use qrm_core::calculus::Calculus;
 use serde::{Deserialize, Serialize};
@@ -33,6 +33,10 @@ pub struct RunSummary {
     /// Landmarks found to mix rocks and split after the fact (`association::audit`).
     #[serde(default)]
     pub landmarks_split: usize,
+    /// Landmarks found to be one rock once the drive was over, and merged (`Mapper::finish`,
+    /// `association::duplicate`).
+    #[serde(default)]
+    pub landmarks_merged: Vec<MergeRecord>,
     /// Observations held back at their station, resolved later (re-tested on a tighter map,
     /// recognised at later stations: `association::recognition`, or named by the drive's
     /// frames once it was over: `Mapper::finish`), and still pending at the end.
@@ -144,6 +148,7 @@ impl RunSummary {
                 .filter(|r| r.fusion.contradiction.is_some())
                 .count(),
             landmarks_split: records.iter().map(|r| r.fusion.splits.len()).sum(),
+            landmarks_merged: mapper.merged.clone(),
             held_back: records
                 .iter()
                 .flat_map(|r| &r.detections)
@@ -247,6 +252,23 @@ impl fmt::Display for RunSummary {
             self.expired_held_back,
             self.pending_held_back
         )?;
+        if !self.landmarks_merged.is_empty() {
+            let merges: Vec<String> = self
+                .landmarks_merged
+                .iter()
+                .map(|m| {
+                    format!(
+                        "{} into {} ({} pairs of stations)",
+                        m.duplicate, m.landmark, m.frame_pairs
+                    )
+                })
+                .collect();
+            writeln!(
+                f,
+                "landmarks found to be one rock once the drive was over, merged: {}",
+                merges.join(", ")
+            )?;
+        }
         if self.recognised_unused > 0 {
             writeln!(
                 f,
