@@ -65,20 +65,8 @@ impl Gallery {
     ) {
         match self.profiles.iter_mut().find(|p| p.landmark == landmark) {
             Some(p) => {
-                let n = p.sightings as f32;
-                let mix = |old: f32, new: f32| (old * n + new) / (n + 1.0);
-                p.appearance = Appearance {
-                    colour: std::array::from_fn(|k| {
-                        mix(p.appearance.colour[k], appearance.colour[k])
-                    }),
-                    brightness: mix(p.appearance.brightness, appearance.brightness),
-                    texture: mix(p.appearance.texture, appearance.texture),
-                    dark_fraction: mix(p.appearance.dark_fraction, appearance.dark_fraction),
-                };
-                p.width = match (p.width, width) {
-                    (Some(a), Some(b)) => Some(a.intersection(b).unwrap_or_else(|| a.hull(b))),
-                    (a, b) => a.or(b),
-                };
+                p.appearance = weighted_mean(&p.appearance, p.sightings, &appearance, 1);
+                p.width = joined(p.width, width);
                 p.sightings += 1;
             }
             None => self.profiles.push(Profile {
@@ -88,6 +76,50 @@ impl Gallery {
                 sightings: 1,
             }),
         }
+    }
+}
+
+impl Gallery {
+    /// Folds landmark `duplicate`'s profile into `landmark`'s (one rock found to have two
+    /// landmarks): the looks averaged over both landmarks' sightings, the widths as
+    /// [`Gallery::observe`] joins them. Nothing changes unless both have a profile.
+    pub fn merge(&mut self, landmark: LandmarkId, duplicate: LandmarkId) {
+        let Some(gone) = self.profile(duplicate).cloned() else {
+            return;
+        };
+        let Some(kept) = self.profiles.iter_mut().find(|p| p.landmark == landmark) else {
+            return;
+        };
+        kept.appearance = weighted_mean(
+            &kept.appearance,
+            kept.sightings,
+            &gone.appearance,
+            gone.sightings,
+        );
+        kept.width = joined(kept.width, gone.width);
+        kept.sightings += gone.sightings;
+        self.profiles.retain(|p| p.landmark != duplicate);
+    }
+}
+
+/// The mean of descriptors `a`, over `n` sightings, and `b`, over `m`.
+fn weighted_mean(a: &Appearance, n: u32, b: &Appearance, m: u32) -> Appearance {
+    let (n, m) = (n as f32, m as f32);
+    let mix = |x: f32, y: f32| (x * n + y * m) / (n + m).max(1.0);
+    Appearance {
+        colour: std::array::from_fn(|k| mix(a.colour[k], b.colour[k])),
+        brightness: mix(a.brightness, b.brightness),
+        texture: mix(a.texture, b.texture),
+        dark_fraction: mix(a.dark_fraction, b.dark_fraction),
+    }
+}
+
+/// Two bounds on one rock's width joined: intersected, or, if they do not meet, their hull
+/// (the evidence disagrees and neither side is trusted over the other).
+fn joined(a: Option<RangeInterval>, b: Option<RangeInterval>) -> Option<RangeInterval> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.intersection(b).unwrap_or_else(|| a.hull(b))),
+        (a, b) => a.or(b),
     }
 }
 
@@ -111,4 +143,33 @@ pub fn chromaticity_distance(a: &Appearance, b: &Appearance, scales: &Appearance
         .sum::<f64>()
         .sqrt()
         / scales.chromaticity
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn looks(brightness: f32) -> Appearance {
+        Appearance {
+            colour: [0.4, 0.3, 0.3],
+            brightness,
+            texture: 0.1,
+            dark_fraction: 0.2,
+        }
+    }
+
+    #[test]
+    fn a_merged_duplicate_joins_its_rocks_looks_by_sightings() {
+        let mut gallery = Gallery::default();
+        for _ in 0..3 {
+            gallery.observe(1, looks(1.0), Some(RangeInterval::new(0.4, 0.8)));
+        }
+        gallery.observe(7, looks(2.0), Some(RangeInterval::new(0.6, 1.0)));
+        gallery.merge(1, 7);
+        assert!(gallery.profile(7).is_none());
+        let kept = gallery.profile(1).expect("the older landmark stays");
+        assert_eq!(kept.sightings, 4);
+        assert!((kept.appearance.brightness - 1.25).abs() < 1e-6);
+        assert_eq!(kept.width, Some(RangeInterval::new(0.6, 0.8)));
+    }
 }

@@ -302,11 +302,7 @@ impl<C: Calculus> Mapper<C> {
                     *c = landmark;
                 }
             }
-            if let Some(profile) = self.gallery.profile(duplicate).cloned() {
-                self.gallery.profiles.retain(|p| p.landmark != duplicate);
-                self.gallery
-                    .observe(landmark, profile.appearance, profile.width);
-            }
+            self.gallery.merge(landmark, duplicate);
             if let Some(last) = last {
                 self.last_seen.record(landmark, last);
             }
