@@ -77,9 +77,7 @@ impl Gallery {
             }),
         }
     }
-}
 
-impl Gallery {
     /// Folds landmark `duplicate`'s profile into `landmark`'s (one rock found to have two
     /// landmarks): the looks averaged over both landmarks' sightings, the widths as
     /// [`Gallery::observe`] joins them. Nothing changes unless both have a profile.
