@@ -30,8 +30,8 @@ pub struct Comparison {
 
 /// Compares the landmarks frame `a` places and `b` does not with those `b` places and `a`
 /// does not, by the motion their shared landmarks agree on; nothing when fewer than
-/// [`FEWEST_OTHERS`] agree. Placements looser than a registration anchors by
-/// ([`ANCHOR_RADIUS_M`]) are left out.
+/// [`FEWEST_OTHERS`] agree ([`Motion::agreed`] says none then). Placements looser than a
+/// registration anchors by ([`ANCHOR_RADIUS_M`]) are left out.
 pub fn compare(a: &Frame, b: &Frame) -> Comparison {
     let pairs = shared_placements(a, b);
     let Some(agree) = Motion::agreed(&pairs, FEWEST_OTHERS) else {
@@ -43,9 +43,6 @@ pub fn compare(a: &Frame, b: &Frame) -> Comparison {
         .filter(|(_, &agrees)| agrees)
         .map(|(pair, _)| *pair)
         .collect();
-    if fitted.len() < FEWEST_OTHERS {
-        return Comparison::default();
-    }
     let forward = Motion::fit(&fitted);
     let swapped: Vec<(Placed, Placed)> = fitted.iter().map(|&(p, q)| (q, p)).collect();
     let backward = Motion::fit(&swapped);

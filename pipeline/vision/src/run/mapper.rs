@@ -246,10 +246,7 @@ impl<C: Calculus> Mapper<C> {
     pub fn finish(&mut self) -> MetricsRecord {
         self.merge_duplicates();
         self.recognise_given_up();
-        let mut stations: BTreeMap<LandmarkId, BTreeSet<usize>> = BTreeMap::new();
-        for &(station, _, l) in &self.sightings {
-            stations.entry(l).or_default().insert(station);
-        }
+        let stations = self.stations_of_landmarks();
         let corroborated =
             |l: LandmarkId| stations.get(&l).map_or(0, BTreeSet::len) >= CORROBORATING_STATIONS;
         self.uncorroborated = self
@@ -266,6 +263,15 @@ impl<C: Calculus> Mapper<C> {
             self.revision += 1;
         }
         self.refresh_metrics()
+    }
+
+    /// The stations each landmark was fused at.
+    fn stations_of_landmarks(&self) -> BTreeMap<LandmarkId, BTreeSet<usize>> {
+        let mut stations: BTreeMap<LandmarkId, BTreeSet<usize>> = BTreeMap::new();
+        for &(station, _, l) in &self.sightings {
+            stations.entry(l).or_default().insert(station);
+        }
+        stations
     }
 
     /// Merges the landmarks that are one rock, once the drive is over: two landmarks never
@@ -322,10 +328,7 @@ impl<C: Calculus> Mapper<C> {
         &self,
         refused: &BTreeSet<(LandmarkId, LandmarkId)>,
     ) -> Option<((LandmarkId, LandmarkId), usize)> {
-        let mut stations: BTreeMap<LandmarkId, BTreeSet<usize>> = BTreeMap::new();
-        for &(station, _, l) in &self.sightings {
-            stations.entry(l).or_default().insert(station);
-        }
+        let stations = self.stations_of_landmarks();
         let n = self.sighted.len();
         let comparisons: Vec<duplicate::Comparison> = (0..n)
             .into_par_iter()
