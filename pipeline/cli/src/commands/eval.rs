@@ -233,8 +233,8 @@ pub fn print_report(e: &Evaluation) {
     );
     let a = &e.association;
     println!(
-        "  association: accuracy {:.3} ({} of {} sightings), purity {:.3} (false detections aside), {} landmarks, {} rocks duplicated, {} landmarks mixed, {} sightings of false detections",
-        a.accuracy, a.correct_sightings, a.sightings, a.purity, a.landmarks, a.duplicated_rocks, a.mixed_landmarks, a.unmatched_sightings
+        "  association: accuracy {:.3} ({} of {} sightings), purity {:.3} (false detections aside; {:.3} by nearest centroid alone, {} sightings of blobs over several rocks counted for the landmark's rock their measurement holds), {} landmarks, {} rocks duplicated, {} landmarks mixed, {} sightings of false detections",
+        a.accuracy, a.correct_sightings, a.sightings, a.purity, a.purity_nearest_centroid, a.credited_by_measurement, a.landmarks, a.duplicated_rocks, a.mixed_landmarks, a.unmatched_sightings
     );
     println!(
         "  reached the map: {:.1} % of detections matched to rocks; {} of the {} rocks detected at 3 or more stations have a landmark ({:.1} %)",

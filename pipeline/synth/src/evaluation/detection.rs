@@ -105,6 +105,36 @@ pub fn match_detections(
     credit(&claims(detections, rocks, width), rocks.len())
 }
 
+/// The rocks of `rocks` that detection `d`, credited with none or another, also shows: a blob
+/// over several touching rocks is credited with one of them (its nearest centroid among those
+/// its measurement holds), yet its measurement may hold its neighbours as well, and then it is
+/// as much a sighting of each (stress clusters: the rock credited changes with the viewpoint
+/// while the blob and its landmark stay the same). Such a rock lies in the detection's rows and
+/// columns, its true bearing and range lie inside the detection's intervals, and no detection
+/// of the image is credited with it.
+pub(super) fn also_shown(
+    d: &DetectedBox,
+    rocks: &[VisibleRock],
+    credited: &[Option<usize>],
+    width: u32,
+) -> Vec<usize> {
+    let Some(measured) = d.measured else {
+        return Vec::new();
+    };
+    rocks
+        .iter()
+        .enumerate()
+        .filter(|&(k, r)| {
+            !credited.contains(&Some(k))
+                && measured.fits(r)
+                && in_columns(r.centroid[0], d.bbox, width)
+                && r.bbox[1] <= d.bbox[3]
+                && r.bbox[3] >= d.bbox[1]
+        })
+        .map(|(k, _)| k)
+        .collect()
+}
+
 /// How near a claimant is to a rock, nearest first: its measurement fits the rock, its centroid
 /// lies in the rock's box, the distance between their centroids.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -412,5 +442,24 @@ mod tests {
             match_detections(&[piece, blob([25.1, 30.4])], &stack(), 4096),
             vec![None, Some(1)]
         );
+    }
+
+    /// A blob over the stack whose range interval holds both rocks: credited with the far
+    /// one (nearest centroid), it also shows the near one, unless another detection is
+    /// credited with it or the interval leaves it out.
+    #[test]
+    fn a_blob_whose_measurement_holds_both_rocks_also_shows_the_one_it_is_not_credited_with() {
+        let both = blob([25.1, 45.0]);
+        let credited = match_detections(&[both], &stack(), 4096);
+        assert_eq!(credited, vec![Some(0)]);
+        assert_eq!(also_shown(&both, &stack(), &credited, 4096), vec![1]);
+        assert!(also_shown(&both, &stack(), &[Some(0), Some(1)], 4096).is_empty());
+        let far_only = blob([30.0, 45.0]);
+        assert!(also_shown(&far_only, &stack(), &credited, 4096).is_empty());
+        let detector_only = DetectedBox {
+            measured: None,
+            ..both
+        };
+        assert!(also_shown(&detector_only, &stack(), &credited, 4096).is_empty());
     }
 }

@@ -1,7 +1,7 @@
 //! Scoring the front end image by image: detections ([`Score`]), bearings, range cues and
 //! the asserted range order, against the truth rock each detection is credited with.
 
-use super::detection::{match_detections, ratio, Detectable, DetectedBox, Score};
+use super::detection::{also_shown, match_detections, ratio, Detectable, DetectedBox, Score};
 use super::{BearingScore, CueScore, DetectionScore, FrontEndScore, RangeScore};
 use crate::dataset::{ImageTruth, Truth};
 use qrm_core::measurement::angular_distance;
@@ -21,6 +21,8 @@ pub(super) struct Tally {
     detection: Score,
     /// Truth rock of every matched `(station index, detection index)`.
     pub matched: HashMap<(usize, usize), u32>,
+    /// Other truth rocks each matched detection also shows ([`also_shown`]).
+    pub also_shows: HashMap<(usize, usize), Vec<u32>>,
     /// Bearing error with interval half-width of every matched detection, of the detections
     /// the run used, of the sightings that reached the map, and of those of the latter that
     /// are pieces of their rock ([`PIECE_SHARE`]).
@@ -71,6 +73,11 @@ impl Tally {
                 continue;
             };
             self.matched.insert((record.index, i), rock.id);
+            let also = also_shown(&boxes[i], &image.rocks, &credited, calib.image.width);
+            if !also.is_empty() {
+                let ids = also.into_iter().map(|k| image.rocks[k].id).collect();
+                self.also_shows.insert((record.index, i), ids);
+            }
             let (bearing, range) = polar(rock.id);
             let error = self.add_bearing(d, bearing);
             if sighting[i] {

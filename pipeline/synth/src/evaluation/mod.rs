@@ -115,12 +115,19 @@ pub struct RangeScore {
 pub struct AssociationScore {
     pub landmarks: usize,
     pub sightings: usize,
-    /// Sightings of the rock their landmark stands for (its majority rock).
+    /// Sightings of the rock their landmark stands for (the rock most of them are credited
+    /// with), a blob over several touching rocks showing each rock its measurement holds
+    /// (`detection::also_shown`).
     pub correct_sightings: usize,
     pub accuracy: f64,
     /// Correct sightings over the sightings that show a rock: the landmarks' purity (issues 13
     /// and 14), which false detections do not lower.
     pub purity: f64,
+    /// Of the correct sightings, those of a blob credited with another of the rocks it shows
+    /// (its nearest centroid), counted for their landmark's rock.
+    pub credited_by_measurement: usize,
+    /// The purity when each sighting shows only the rock it is credited with (before stop 79).
+    pub purity_nearest_centroid: f64,
     /// Rocks with more than one landmark, and landmarks whose sightings span several rocks.
     pub duplicated_rocks: usize,
     pub mixed_landmarks: usize,
@@ -144,7 +151,7 @@ pub struct AssociationScore {
 pub struct MixedLandmark {
     pub landmark: LandmarkId,
     /// Each rock it was fused from, with the stations (indices into `stations.json`) whose
-    /// sightings show it, most sighted rock first.
+    /// sightings show it: the rock the landmark stands for first, then by sightings.
     pub rocks: Vec<(u32, Vec<usize>)>,
 }
 
@@ -315,7 +322,7 @@ pub fn score_run(
     for (record, image) in eval_records(run.records, truth) {
         tally.add_image(record, image, truth, calib, detectable, &fused);
     }
-    let (association, rocks) = association::score(run.landmarks, &tally.matched);
+    let (association, rocks) = association::score(run.landmarks, &tally.matched, &tally.also_shows);
     Evaluation {
         front_end: tally.scores(),
         association,
