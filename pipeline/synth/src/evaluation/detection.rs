@@ -105,7 +105,7 @@ pub fn match_detections(
     credit(&claims(detections, rocks, width), rocks.len())
 }
 
-/// The rocks of `rocks` that detection `d`, credited with none or another, also shows: a blob
+/// The rocks of `rocks` that detection `d` shows besides the one it is credited with: a blob
 /// over several touching rocks is credited with one of them (its nearest centroid among those
 /// its measurement holds), yet its measurement may hold its neighbours as well, and then it is
 /// as much a sighting of each (stress clusters: the rock credited changes with the viewpoint

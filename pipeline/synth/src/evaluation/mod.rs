@@ -115,8 +115,8 @@ pub struct RangeScore {
 pub struct AssociationScore {
     pub landmarks: usize,
     pub sightings: usize,
-    /// Sightings of the rock their landmark stands for (the rock most of them are credited
-    /// with), a blob over several touching rocks showing each rock its measurement holds
+    /// Sightings of the rock their landmark stands for (the rock most of them show), a blob
+    /// over several touching rocks showing each rock its measurement holds
     /// (`detection::also_shown`).
     pub correct_sightings: usize,
     pub accuracy: f64,
