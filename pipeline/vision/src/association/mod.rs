@@ -181,6 +181,10 @@ pub struct Evidence {
     pub surely_flat: bool,
     /// Rock pixels of the detection: too few ([`MIN_FOUNDING_PIXELS`]) describe no looks.
     pub pixels: u32,
+    /// Both independent range cues, the ground contact and stereo, bound it and agree: its
+    /// placement rests on two measurements, not on one that may be wrong (a rock's lit top
+    /// taken for the whole rock puts its contact on the rock's own body).
+    pub corroborated: bool,
 }
 
 /// One station as association sees it: the bearings and range order of its usable detections,
@@ -1182,6 +1186,7 @@ mod tests {
                 flat: false,
                 surely_flat: false,
                 pixels: 100,
+                corroborated: true,
             })
             .collect();
         (

@@ -416,11 +416,15 @@ fn neighbours<'a>(
             && !(me.separation == Separation::Nearer
                 && other.separation == Separation::Farther
                 && other.blob == me.blob)
-            && columns_overlap(me.bbox, other.bbox, 2, width)
-            && other.bbox[1] <= me.bbox[3]
-            && me.bbox[1] <= other.bbox[3])
-            .then_some(other)
+            && boxes_touch(me.bbox, other.bbox, width))
+        .then_some(other)
     })
+}
+
+/// Whether two detections' boxes touch side by side: their columns within two of each other
+/// (either may wrap the panorama `width`), their rows overlapping.
+pub(crate) fn boxes_touch(a: [u32; 4], b: [u32; 4], width: u32) -> bool {
+    columns_overlap(a, b, 2, width) && b[1] <= a[3] && a[1] <= b[3]
 }
 
 /// Columns before and after detection `index`'s box that the detections touching it cover:

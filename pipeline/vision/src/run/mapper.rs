@@ -104,6 +104,9 @@ struct HeldBack {
     /// [`Unfounded`]), recorded unused: not held back, only named at the end of the drive
     /// ([`Mapper::recognise_given_up`]).
     withheld: bool,
+    /// Its box in the image: observations of one station whose boxes touch may be one rock's
+    /// pieces, or neighbours of one cluster.
+    bbox: [u32; 4],
 }
 
 /// A station whose detections registered against no frame and were all held back, then
@@ -883,11 +886,16 @@ impl<C: Calculus> Mapper<C> {
     /// the unambiguous-partner test of a live recognition
     /// ([`crate::association::unmapped_rocks_named`]), when no frame names another, it may
     /// have been that landmark ([`Mapper::may_have_been`]), it is not flat, and the map does
-    /// not reject it ([`Mapper::allows`]). A live recognition needs a later station within
-    /// [`RECENT_FRAMES`] that anchors the rock; a rock founded later, or seen again only
-    /// after the rover came back, never had one (colour marsyard s31 at stop 75: of 60 pieces of
-    /// mapped rocks left unused, 55 were of rocks founded 1–20 stations after them, 19 with no
-    /// station anchoring it within the window; stop 76, docs/RUN.md).
+    /// not reject it ([`Mapper::allows`]). A naming that needed the map to rule a rival out
+    /// ([`Mapper::frames_naming`]) is not made while an observation touching it at its
+    /// station was held back with the same landmark among its candidates: the frames cannot
+    /// tell which of the two the landmark is (stress s4: the blob of a cluster and a whole
+    /// rock 0.8 m from it, both held with the cluster's landmark at 20 stations). A live
+    /// recognition needs a later station within [`RECENT_FRAMES`] that anchors the rock; a
+    /// rock founded later, or seen again only after the rover came back, never had one (colour
+    /// marsyard s31 at stop 75: of 60 pieces of mapped rocks left unused, 55 were of rocks
+    /// founded 1–20 stations after them, 19 with no station anchoring it within the window;
+    /// stop 76, docs/RUN.md).
     fn recognise_given_up(&mut self) {
         let given_up = std::mem::take(&mut self.given_up);
         let pending = std::mem::take(&mut self.held);
@@ -898,9 +906,19 @@ impl<C: Calculus> Mapper<C> {
             .chain(pending.into_iter().map(|item| (item, false)))
             .collect();
         let mut fused = vec![false; items.len()];
+        let width = self.calib.image.width;
         for k in 0..items.len() {
             let item = &items[k].0;
-            let Some(landmark) = names[k].filter(|&l| {
+            let contested = |l: LandmarkId| {
+                items.iter().any(|(other, _)| {
+                    other.station == item.station
+                        && other.detection != item.detection
+                        && other.candidates.contains(&l)
+                        && ranging::boxes_touch(other.bbox, item.bbox, width)
+                })
+            };
+            let named = names[k].filter(|&(l, by_map)| !(by_map && contested(l)));
+            let Some(landmark) = named.map(|(l, _)| l).filter(|&l| {
                 !item.evidence.flat
                     && !item.decided.iter().any(|d| d.landmark == l)
                     && self.may_have_been(item, l)
@@ -945,11 +963,16 @@ impl<C: Calculus> Mapper<C> {
     /// another, and each of its rivals (its candidates and the landmarks it looks like,
     /// [`look_alikes`]) is fused at its station or held by a naming frame, which places it
     /// elsewhere. A rival none of them holds may be the rock (colour marsyard s41: a blob of
-    /// two rocks 1.4 m apart named as the one whose landmark the naming frames held).
+    /// two rocks 1.4 m apart, named as the one whose landmark the naming frames held), unless
+    /// the map rejects the observation as that rival (000 §VI-C's test) and the observation's
+    /// range is corroborated, so that the rejection does not rest on one cue that may be wrong
+    /// (colour marsyard s13: the lit top of a rock at 1.7 m, read as standing at 2.6 m, named
+    /// against a rival rejected through that range made the map unsound). With each landmark,
+    /// whether the map had to rule out a rival.
     fn frames_naming<'a>(
         &self,
         items: impl Iterator<Item = &'a HeldBack> + Clone,
-    ) -> Vec<Option<LandmarkId>> {
+    ) -> Vec<Option<(LandmarkId, bool)>> {
         let stations: BTreeSet<usize> = items.clone().map(|item| item.station).collect();
         // (station, unmapped rock of its frame) → the landmarks other frames put on it, and
         // every landmark those frames hold.
@@ -984,15 +1007,26 @@ impl<C: Calculus> Mapper<C> {
                 let g = sighted.frame.unmapped.iter().position(|&u| u == placed)?;
                 let (names, held) = named.get(&(item.station, g))?;
                 let l = names[0];
+                if names.len() < RECOGNITIONS || names.iter().any(|&m| m != l) {
+                    return None;
+                }
                 let accounted = |r: LandmarkId| {
                     r == l || held.contains(&r) || item.decided.iter().any(|d| d.landmark == r)
                 };
-                let rivals_accounted = item.candidates.iter().all(|&r| accounted(r))
-                    && look_alikes(&item.evidence, &self.gallery, &self.association)
-                        .into_iter()
-                        .all(accounted);
-                (names.len() >= RECOGNITIONS && names.iter().all(|&m| m == l) && rivals_accounted)
-                    .then_some(l)
+                let mut rivals = item
+                    .candidates
+                    .iter()
+                    .copied()
+                    .chain(look_alikes(
+                        &item.evidence,
+                        &self.gallery,
+                        &self.association,
+                    ))
+                    .filter(|&r| !accounted(r))
+                    .peekable();
+                let by_map = rivals.peek().is_some();
+                let ruled_out = rivals.all(|r| item.evidence.corroborated && !self.allows(item, r));
+                ruled_out.then_some((l, by_map))
             })
             .collect()
     }
@@ -1237,6 +1271,11 @@ impl<C: Calculus> Mapper<C> {
         view: Arc<StationView>,
     ) {
         let station = record.index;
+        let boxes: Vec<[u32; 4]> = associated
+            .usable
+            .iter()
+            .map(|&i| record.detections[i].bbox)
+            .collect();
         let observation = |position: usize, candidates: Vec<LandmarkId>, withheld: bool| HeldBack {
             station,
             view: Arc::clone(&view),
@@ -1248,6 +1287,7 @@ impl<C: Calculus> Mapper<C> {
             recognised: Vec::new(),
             founded_after: associated.next_landmark,
             withheld,
+            bbox: boxes[position],
         };
         for (position, candidates) in &associated.held {
             record.detections[associated.usable[*position]].association = Association::HeldBack {
@@ -1665,10 +1705,12 @@ mod tests {
                 flat: false,
                 surely_flat: false,
                 pixels: 100,
+                corroborated: true,
             },
             recognised: Vec::new(),
             founded_after: LandmarkId::MAX,
             withheld: false,
+            bbox: [0, 0, 9, 9],
         });
         seen.placed[k]
     }
@@ -1812,6 +1854,57 @@ mod tests {
         assert!(mapper.recognised_at_end.is_empty());
         assert_eq!(mapper.given_up.len(), 1);
         assert_eq!(mapper.expired, 1);
+    }
+
+    /// The observation given up at station 2 with landmarks 15 and 7 for candidates, no
+    /// naming frame holding 7 (rock 7, 11 m down the drive, seen from station 4 on): a rival
+    /// only the map can rule out. Returns its position.
+    fn given_up_with_a_rival_only_the_map_rejects(
+        mapper: &mut Mapper<Edc>,
+        corroborated: bool,
+    ) -> usize {
+        let k = given_up_at_station_2(mapper, vec![15, 7]);
+        for sighted in &mut mapper.sighted {
+            sighted.frame.landmarks.retain(|&(l, _)| l != 7);
+        }
+        mapper.given_up[0].evidence.corroborated = corroborated;
+        k
+    }
+
+    /// The map rejects rock 15's observation as landmark 7, and the observation's range is
+    /// corroborated: the rival is ruled out, and the frames' naming stands.
+    #[test]
+    fn a_rival_the_map_rejects_rules_itself_out_for_a_corroborated_observation() {
+        let mut mapper = test_mapper();
+        let k = given_up_with_a_rival_only_the_map_rejects(&mut mapper, true);
+        assert!(!mapper.allows(&mapper.given_up[0], 7));
+        mapper.finish();
+        assert_named_15_at_end(&mapper, k);
+        assert_eq!(unsound(&mapper.map, |l| l as usize), 0);
+    }
+
+    /// Without corroboration the map's rejection rests on one range cue that may be wrong: the
+    /// rival stands, and so does an observation touching it held with the same landmark.
+    #[test]
+    fn a_rival_the_map_rejects_stands_without_corroboration_or_beside_a_contested_observation() {
+        let mut mapper = test_mapper();
+        given_up_with_a_rival_only_the_map_rejects(&mut mapper, false);
+        mapper.finish();
+        assert!(mapper.recognised_at_end.is_empty());
+        assert_eq!(mapper.given_up.len(), 1);
+
+        let mut mapper = test_mapper();
+        let k = given_up_with_a_rival_only_the_map_rejects(&mut mapper, true);
+        let mut beside = mapper.given_up[0].clone();
+        mapper.given_up[0].bbox = [100, 50, 120, 60];
+        beside.bbox = [122, 52, 140, 62];
+        beside.detection = (k + 1) % beside.view.bearings.len();
+        beside.candidates = vec![15];
+        beside.evidence.placed = None;
+        mapper.held.push(beside);
+        mapper.finish();
+        assert!(mapper.recognised_at_end.is_empty());
+        assert!(mapper.given_up.iter().any(|item| item.detection == k));
     }
 
     /// Rock 15's detection at station 2 as a piece that matched no landmark and founded none,

@@ -137,6 +137,7 @@ pub(crate) fn station_evidence(
                 flat: station.primary[i].flat,
                 surely_flat: station.primary[i].surely_flat,
                 pixels: station.primary[i].pixels,
+                corroborated: corroborated(&ranged[i]),
             })
             .collect(),
         colour: station.channels == Channels::Colour,
