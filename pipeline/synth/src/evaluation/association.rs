@@ -52,10 +52,11 @@ pub(super) fn score(
             .filter_map(|s| matched.get(s).map(|&id| (*s, id)))
             .collect();
         a.unmatched_sightings += landmark.sightings.len() - shown.len();
-        let Some(rock) = landmark_rock(&shown, also_shows) else {
+        let credited = credited_counts(&shown);
+        let Some(rock) = landmark_rock(&shown, &credited, also_shows) else {
             continue;
         };
-        correct_by_centroid += credited_counts(&shown).values().copied().max().unwrap_or(0);
+        correct_by_centroid += credited.values().copied().max().unwrap_or(0);
         let mut stations: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
         for &(s, id) in &shown {
             let shows = id == rock || also_shows.get(&s).is_some_and(|r| r.contains(&rock));
@@ -115,12 +116,12 @@ fn credited_counts(shown: &[((usize, usize), u32)]) -> BTreeMap<u32, usize> {
 /// The rock a landmark stands for: the one the most of its sightings show, credited with it or
 /// also showing it (a blob over touching rocks, stress clusters: the map's relations of the
 /// landmark hold for the rock its measurements hold); among as many, the one credited with
-/// more, then the lowest id.
+/// more (`credited`, by [`credited_counts`]), then the lowest id.
 fn landmark_rock(
     shown: &[((usize, usize), u32)],
+    credited: &BTreeMap<u32, usize>,
     also_shows: &HashMap<(usize, usize), Vec<u32>>,
 ) -> Option<u32> {
-    let credited = credited_counts(shown);
     let mut showing: BTreeMap<u32, usize> = BTreeMap::new();
     for &(s, id) in shown {
         *showing.entry(id).or_default() += 1;
