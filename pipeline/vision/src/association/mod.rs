@@ -19,11 +19,12 @@
 //!    make while a significant fit holding its landmark leaves it out ([`overruled`]). A
 //!    detection the detector doubts ([`Evidence::doubtful`]) takes no part in the fit: each
 //!    registration pairs it afterwards under its motion ([`Registration::pair_observers`]),
-//!    and it anchors only as a far rock does. Anchors are checked against each other: a
-//!    triple of anchors whose measured states do not overlap the map's is inconsistent, and
-//!    the anchor in most such triples is dropped until none is left. Matches are then checked
-//!    against earlier stations' placements of their landmarks ([`agreement`], applied by the
-//!    caller, which keeps the stations' history);
+//!    and it anchors only as a far rock does, or, by luminance and placed within 2 m, on the
+//!    sketch's pairing alone where no station's frame holds the landmark. Anchors are checked
+//!    against each other: a triple of anchors whose measured states do not overlap the map's
+//!    is inconsistent, and the anchor in most such triples is dropped until none is left.
+//!    Matches are then checked against earlier stations' placements of their landmarks
+//!    ([`agreement`], applied by the caller, which keeps the stations' history);
 //! 3. every other proposal is tested as 000 §VI-C describes: the detection's triples with
 //!    pairs of anchors are measured and compared with the candidate landmark's relations in
 //!    the map; a candidate with an empty overlap in any relation is rejected;
@@ -171,7 +172,8 @@ pub struct Evidence {
     /// Doubted by the detector (a piece cut at a shallow notch, or beside a nearer piece that
     /// may hide some of it), or by luminance a piece, whose placement is looser than its
     /// interval says: it observes landmarks, steers no registration, founds none, and anchors
-    /// only as a far rock does, where every registered frame holding the landmark pairs it.
+    /// only where every registered frame holding the landmark pairs it, as a far rock does
+    /// (`long_anchor`).
     pub doubtful: bool,
     /// Nothing of it stands up from the ground by stereo ([`crate::detection::Detection::flat`]):
     /// a soil patch or a shadow, or a rock too smooth to tell.
@@ -851,13 +853,26 @@ fn placed_near(
         .collect()
 }
 
-/// Whether a pair of a detection placed looser than [`ANCHOR_RADIUS_M`] (a far rock) with
-/// landmark `l` anchors: every registered frame holding `l` makes it (`holding`), two or more
-/// do, one a station's frame (the sketch's averaged positions alone re-identified a far rock's
-/// neighbour: JPEG marsyard seed 3, station 40), and none knows another rock where the pair's
-/// placement lies ([`Registration::crowded`]). Far rocks are held back otherwise, and where
-/// they stand apart (sparse fields) the map loses most of them; where they cluster, a far
-/// placement reaches several.
+/// Whether a pair that does not anchor on the usual terms, of a detection placed looser than
+/// [`ANCHOR_RADIUS_M`] (a far rock) or of an observer, with landmark `l` anchors: every
+/// registered frame holding `l` makes it (`holding`), none knows another rock where the pair's
+/// placement lies ([`Registration::crowded`]), and two or more do, one a station's frame (the
+/// sketch's averaged positions alone re-identified a far rock's neighbour: JPEG marsyard seed
+/// 3, station 40). Far rocks are held back otherwise, and where they stand apart (sparse
+/// fields) the map loses most of them; where they cluster, a far placement reaches several.
+///
+/// An observer placed within [`ANCHOR_RADIUS_M`] does not reach past its rock that way, and by
+/// luminance (`fragmented`) the sketch alone may pair it where no station's frame holds `l`:
+/// the sketch keeps the landmarks of the last [`sketch::WINDOW`] stations, the recent frames
+/// those of the last few. By luminance the detector breaks rocks into pieces, and most pieces
+/// the stereo test does not corroborate, paired with their own rock's landmark, were refused
+/// so (grayscale marsyard seed 41: 41 of 42 refusals of a lone pairing were the sketch's);
+/// letting them anchor raised the fused share of 17 of 22 luminance sets by 1.0–8.9 points
+/// (grayscale marsyard seed 53: 72.6 → 81.5 %), the other five moving by −0.5 to +0.2, with no
+/// relation unsound. In colour an observer is a cut the detector doubts: there it changed no
+/// colour marsyard seed, and on stress seed 49 its few sightings tipped a landmark that
+/// already held two rocks 0.9 m apart into the second one's (8 unsound relations; docs/RUN.md,
+/// stop 80).
 fn long_anchor(
     supporting: &[&(&Frame, Registration)],
     holding: usize,
@@ -869,9 +884,12 @@ fn long_anchor(
     let Some(p) = placed else {
         return false;
     };
+    let enough = match supporting {
+        [(only, _)] => fragmented && only.accumulated && p.reach() <= ANCHOR_RADIUS_M,
+        _ => supporting.len() >= 2 && supporting.iter().any(|(frame, _)| !frame.accumulated),
+    };
     supporting.len() == holding
-        && supporting.len() >= 2
-        && supporting.iter().any(|(frame, _)| !frame.accumulated)
+        && enough
         && supporting
             .iter()
             .all(|(frame, r)| !r.crowded(frame, &p, l, others, fragmented))
@@ -1594,6 +1612,55 @@ mod tests {
             (&landmark, pairing.clone()),
             (&beside, pairing)
         ]));
+    }
+
+    /// By luminance an observer placed within 2 m anchors on the sketch's pairing alone where no
+    /// station's frame holds the landmark, unless the sketch knows another rock within its
+    /// reach; a far one, one only a station's frame pairs, or one seen in colour does not.
+    #[test]
+    fn a_near_observer_anchors_on_the_sketch_alone_by_luminance() {
+        let candidates = vec![vec![(0, 0.1)]];
+        let pairing = Registration {
+            pairs: vec![(0, 0)],
+            motion: [1.0, 0.0, 0.0, 0.0],
+            nfa: 0.0,
+        };
+        let sketch = |points: &[[f64; 2]]| Frame {
+            accumulated: true,
+            ..frame(points)
+        };
+        let anchored = |registrations: &[(&Frame, Registration)], reach: f64, luminance: bool| {
+            let placed = [Some(Placed::along([10.0, 0.0], 0.0, reach, 0.1))];
+            !anchors(registrations, &candidates, &placed, &[true], 1, luminance).is_empty()
+        };
+        let alone = |frame: &Frame, reach: f64| anchored(&[(frame, pairing.clone())], reach, true);
+        assert!(alone(&sketch(&[[10.0, 0.0]]), 1.5));
+        assert!(!alone(&sketch(&[[10.0, 0.0]]), 3.0), "a far observer");
+        assert!(
+            !alone(&sketch(&[[10.0, 0.0], [11.0, 0.0]]), 1.5),
+            "another landmark within its reach"
+        );
+        assert!(
+            !alone(&frame(&[[10.0, 0.0]]), 1.5),
+            "a station's frame alone"
+        );
+        assert!(
+            !anchored(&[(&sketch(&[[10.0, 0.0]]), pairing.clone())], 1.5, false),
+            "in colour"
+        );
+        // A station's frame that holds the landmark and leaves the pair out doubts it.
+        let silent = Registration {
+            pairs: Vec::new(),
+            ..pairing.clone()
+        };
+        assert!(!anchored(
+            &[
+                (&sketch(&[[10.0, 0.0]]), pairing.clone()),
+                (&frame(&[[10.0, 0.0]]), silent)
+            ],
+            1.5,
+            true
+        ));
     }
 
     /// A detection the detector doubts (a piece cut at a shallow notch, or beside a nearer
