@@ -864,15 +864,15 @@ fn placed_near(
 /// An observer placed within [`ANCHOR_RADIUS_M`] does not reach past its rock that way, and by
 /// luminance (`fragmented`) the sketch alone may pair it where no station's frame holds `l`:
 /// the sketch keeps the landmarks of the last [`sketch::WINDOW`] stations, the recent frames
-/// those of the last few. By luminance the detector breaks rocks into pieces, and most pieces
-/// the stereo test does not corroborate, paired with their own rock's landmark, were refused
-/// so (grayscale marsyard seed 41: 41 of 42 refusals of a lone pairing were the sketch's);
-/// letting them anchor raised the fused share of 17 of 22 luminance sets by 1.0–8.9 points
-/// (grayscale marsyard seed 53: 72.6 → 81.5 %), the other five moving by −0.5 to +0.2, with no
-/// relation unsound. In colour an observer is a cut the detector doubts: there it changed no
-/// colour marsyard seed, and on stress seed 49 its few sightings tipped a landmark that
-/// already held two rocks 0.9 m apart into the second one's (8 unsound relations; docs/RUN.md,
-/// stop 80).
+/// those of the last few. By luminance the detector breaks rocks into pieces, and pieces the
+/// stereo test does not corroborate, paired with their own rock's landmark, were refused so
+/// (grayscale marsyard seed 41: 40 of 41 refusals of an observer's lone pairing were the
+/// sketch's); letting them anchor raised the fused share of 17 of 22 luminance sets by
+/// 1.0–8.9 points (grayscale marsyard seed 53: 72.6 → 81.5 %), the other five moving by −0.5
+/// to +0.2, with no relation unsound. In colour an observer is a cut the detector doubts:
+/// there it changed no colour marsyard seed, and on stress seed 49 its few sightings tipped a
+/// landmark that already held two rocks 0.9 m apart into the second one's (8 unsound
+/// relations; docs/RUN.md, stop 80).
 fn long_anchor(
     supporting: &[&(&Frame, Registration)],
     holding: usize,
