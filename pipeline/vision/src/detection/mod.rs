@@ -405,15 +405,9 @@ fn detect_in(
                 pixel_shifts,
             } = layer;
             // A part separated by parallax has its shifts; a whole blob's pieces take theirs
-            // from its pixels', in colour mode. By luminance a piece so ranged steers the fit
-            // where its ground and stereo cues agree (`run::selection::corroborated`), and
-            // luminance pieces are often parts of a rock: JPEG marsyard seed 47 fell 70.8 →
-            // 65.6 % fused, and stress seed 9 lost its first registration (50.8 → 42.0 %, 10
-            // rocks duplicated; docs/RUN.md, stop 69).
-            let lookup = parallax::ShiftLookup::new(
-                &pixels,
-                if luminance { Vec::new() } else { pixel_shifts },
-            );
+            // from its pixels'. Ranging decides when they stand in for a stereo partner (by
+            // luminance only where the piece's contact is hidden: `ranging::observe`).
+            let lookup = parallax::ShiftLookup::new(&pixels, pixel_shifts);
             pieces(pixels, part, rule).into_iter().map(move |piece| {
                 let shifts = shifts.or_else(|| lookup.range_of(&piece.pixels));
                 (blob, piece, part, shifts)

@@ -218,6 +218,16 @@ pub fn observe(
                 (columns + beyond) * calib.column_width()
             });
             let ground = ground_cue(d, i, primary, calib, model, reach_width, half_baseline);
+            // By luminance a piece whose ground and stereo cues agree steers registrations
+            // (`run::selection::corroborated`), and the luminance detector's pieces are often
+            // parts of a rock: given its pixels' shifts wherever it has a ground cue too, JPEG
+            // marsyard s47 fell 70.8 → 65.6 % fused (stop 69). Where a nearer detection hides
+            // its contact, the shifts are its only range: without them its bearing spans the
+            // left eye's offsets at any range and it is left out (`WideBearing`; 122 correct
+            // detections on grayscale marsyard s7), with them it observes (stop 81, docs/RUN.md).
+            let piece_stereo = |ground: Option<RangeInterval>| {
+                piece && (channels != Channels::Luminance || ground.is_none())
+            };
             let right_detection = matches[i].zip(right).map(|(j, r)| &r[j]);
             let stereo = right_detection
                 .and_then(|r| stereo_cue(d, r, calib, model, angular_width))
@@ -227,7 +237,7 @@ pub fn observe(
                 // stress s10 had 5 and 3 unsound relations, docs/RUN.md stop 66).
                 .or_else(|| {
                     parallax_cue(d, calib, model, reach_width)
-                        .filter(|_| piece || d.separation != Separation::Whole)
+                        .filter(|_| d.separation != Separation::Whole || piece_stereo(ground))
                 });
             let (fused, conflict) = fuse([ground, stereo, None]);
             // The ray is where the detection itself was seen; a piece's bearing takes in the
@@ -1106,6 +1116,70 @@ mod tests {
         // The lone detection keeps the centroid's own error.
         let lone = ranged[2].bearing;
         assert!(holds(lone, 410.0) && !holds(lone, 416.0), "{lone:?}");
+    }
+
+    /// A piece's own pixels' shifts range it where no partner can: in colour always, by
+    /// luminance only where a nearer detection hides its contact. There they are its only
+    /// range, and its bearing, without them as wide as the left eye's offsets at any range,
+    /// narrows to those of its stereo interval; a luminance piece with a ground cue keeps that
+    /// cue alone, as its ground and stereo cues agreeing would let it steer registrations.
+    #[test]
+    fn by_luminance_a_piece_takes_its_pixels_shifts_only_where_its_contact_is_hidden() {
+        let calib = half_resolution_stereo();
+        let model = SensorModel::default();
+        let shift = calib.stereo_disparity(5.0) / calib.column_width();
+        let shifted = |bbox, shifts: Option<[f64; 2]>| Detection {
+            parallax_shifts: shifts,
+            ..blob(bbox, Separation::Whole)
+        };
+        let primary = |shifts| {
+            [
+                shifted([100, 200, 119, 230], shifts),
+                shifted([120, 200, 139, 230], shifts),
+                shifted([90, 225, 112, 260], shifts),
+            ]
+        };
+        let seen = |channels, shifts| {
+            observe(
+                &primary(shifts),
+                None,
+                PrimaryEye::Left,
+                channels,
+                &calib,
+                &model,
+            )
+        };
+        let shifts = Some([shift - 0.5, shift + 0.5]);
+        let colour = seen(Channels::Colour, shifts);
+        let luminance = seen(Channels::Luminance, shifts);
+        assert!(colour.iter().chain(&luminance).all(|r| r.piece));
+        assert!(colour.iter().all(|r| r.stereo.is_some()));
+        // The first piece's contact lies behind the third; the others' show.
+        assert_eq!(
+            luminance
+                .iter()
+                .map(|r| r.ground.is_some())
+                .collect::<Vec<_>>(),
+            [false, true, true]
+        );
+        assert_eq!(
+            luminance
+                .iter()
+                .map(|r| r.stereo.is_some())
+                .collect::<Vec<_>>(),
+            [true, false, false]
+        );
+        let hidden = luminance[0];
+        assert!(
+            hidden.fused.low <= 5.0 && 5.0 <= hidden.fused.high,
+            "{hidden:?}"
+        );
+        let unranged = seen(Channels::Luminance, None)[0];
+        assert_eq!(unranged.fused, RangeInterval::unbounded());
+        assert!(
+            hidden.bearing.uncertainty < 0.5 * unranged.bearing.uncertainty,
+            "{hidden:?} against {unranged:?}"
+        );
     }
 
     #[test]
