@@ -183,10 +183,11 @@ pub struct Evidence {
     pub surely_flat: bool,
     /// Rock pixels of the detection: too few ([`MIN_FOUNDING_PIXELS`]) describe no looks.
     pub pixels: u32,
-    /// Both independent range cues, the ground contact and stereo, bound it and agree: its
-    /// placement rests on two measurements, not on one that may be wrong (a rock's lit top
-    /// taken for the whole rock puts its contact on the rock's own body).
-    pub corroborated: bool,
+    /// Its range rests on what measures the rock itself: the ground contact and stereo bound
+    /// it and agree, or stereo bounds it where no ground cue applies. The ground cue alone may
+    /// be wrong by a whole rock (a rock's lit top taken for the whole rock puts its contact on
+    /// the rock's own body).
+    pub range_trusted: bool,
 }
 
 /// One station as association sees it: the bearings and range order of its usable detections,
@@ -1204,7 +1205,7 @@ mod tests {
                 flat: false,
                 surely_flat: false,
                 pixels: 100,
-                corroborated: true,
+                range_trusted: true,
             })
             .collect();
         (

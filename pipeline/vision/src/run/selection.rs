@@ -97,6 +97,14 @@ fn corroborated(r: &Ranged) -> bool {
     matches!((r.ground, r.stereo), (Some(g), Some(s)) if g.intersection(s).is_some())
 }
 
+/// Whether the detection's range rests on what measures the rock itself: both cues agreeing,
+/// or stereo where no ground cue applies (its contact hidden by a nearer detection or below
+/// the image). A ground cue alone may be off by a whole rock: a lit top taken for the rock
+/// puts its contact on the rock's own body (`association::Evidence::range_trusted`).
+fn range_trusted(r: &Ranged) -> bool {
+    corroborated(r) || (r.ground.is_none() && r.stereo.is_some())
+}
+
 /// Whether the detector doubts the detection is one whole rock (a piece cut at a shallow
 /// notch, or beside a nearer piece that may hide some of it; by luminance also a top without
 /// its body). The farther part of a blob separated by parallax is flagged too, but its bearing
@@ -137,7 +145,7 @@ pub(crate) fn station_evidence(
                 flat: station.primary[i].flat,
                 surely_flat: station.primary[i].surely_flat,
                 pixels: station.primary[i].pixels,
-                corroborated: corroborated(&ranged[i]),
+                range_trusted: range_trusted(&ranged[i]),
             })
             .collect(),
         colour: station.channels == Channels::Colour,
@@ -287,6 +295,29 @@ mod tests {
             cut_off: false,
             lit_face: 0.0,
         }
+    }
+
+    /// A range is trusted where both cues agree or stereo alone ranges a detection without a
+    /// ground cue; not on the ground cue alone, nor where the two disagree.
+    #[test]
+    fn a_range_is_trusted_on_agreeing_cues_or_on_stereo_without_a_ground_cue() {
+        let cue = RangeInterval::new;
+        let with = |ground, stereo| Ranged {
+            ground,
+            stereo,
+            ..ranged(0.01)
+        };
+        assert!(range_trusted(&with(
+            Some(cue(4.0, 5.0)),
+            Some(cue(4.5, 6.0))
+        )));
+        assert!(range_trusted(&with(None, Some(cue(4.5, 6.0)))));
+        assert!(!range_trusted(&with(Some(cue(4.0, 5.0)), None)));
+        assert!(!range_trusted(&with(
+            Some(cue(4.0, 5.0)),
+            Some(cue(6.0, 7.0))
+        )));
+        assert!(!range_trusted(&with(None, None)));
     }
 
     /// Each detection left out says why, and only those left out are not usable: pieces
