@@ -225,9 +225,7 @@ pub fn observe(
             // its contact, the shifts are its only range: without them its bearing spans the
             // left eye's offsets at any range and it is left out (`WideBearing`; 122 correct
             // detections on grayscale marsyard s7), with them it observes (stop 81, docs/RUN.md).
-            let piece_stereo = |ground: Option<RangeInterval>| {
-                piece && (channels != Channels::Luminance || ground.is_none())
-            };
+            let piece_stereo = piece && (channels != Channels::Luminance || ground.is_none());
             let right_detection = matches[i].zip(right).map(|(j, r)| &r[j]);
             let stereo = right_detection
                 .and_then(|r| stereo_cue(d, r, calib, model, angular_width))
@@ -237,7 +235,7 @@ pub fn observe(
                 // stress s10 had 5 and 3 unsound relations, docs/RUN.md stop 66).
                 .or_else(|| {
                     parallax_cue(d, calib, model, reach_width)
-                        .filter(|_| d.separation != Separation::Whole || piece_stereo(ground))
+                        .filter(|_| d.separation != Separation::Whole || piece_stereo)
                 });
             let (fused, conflict) = fuse([ground, stereo, None]);
             // The ray is where the detection itself was seen; a piece's bearing takes in the
@@ -1154,20 +1152,13 @@ mod tests {
         let luminance = seen(Channels::Luminance, shifts);
         assert!(colour.iter().chain(&luminance).all(|r| r.piece));
         assert!(colour.iter().all(|r| r.stereo.is_some()));
-        // The first piece's contact lies behind the third; the others' show.
+        // The first piece's contact lies behind the third, the others' show: (ground, stereo).
         assert_eq!(
             luminance
                 .iter()
-                .map(|r| r.ground.is_some())
+                .map(|r| (r.ground.is_some(), r.stereo.is_some()))
                 .collect::<Vec<_>>(),
-            [false, true, true]
-        );
-        assert_eq!(
-            luminance
-                .iter()
-                .map(|r| r.stereo.is_some())
-                .collect::<Vec<_>>(),
-            [true, false, false]
+            [(false, true), (true, false), (true, false)]
         );
         let hidden = luminance[0];
         assert!(
