@@ -60,7 +60,7 @@ use gallery::chromaticity_distance;
 pub use gallery::{distance, AppearanceScales, Gallery, Profile};
 pub use placement::Placed;
 pub use recency::LastSeen;
-pub use recognition::{unmapped_rocks_named, Recognition};
+pub use recognition::{read_unmapped, Recognition, UnmappedReading};
 pub use registration::{displacement, register, Frame, Registration, Tracked};
 use registration::{ANCHOR_RADIUS_M, LONG_ANCHOR_RADIUS_M, MIN_INLIERS, SIGNIFICANT_NFA};
 pub use sketch::Sketch;

@@ -78,22 +78,38 @@ pub fn recognitions(
         .collect()
 }
 
-/// The unmapped rocks of station frame `frame` that landmarks of another station's frame
-/// `other` lie on: (index into [`Frame::unmapped`], landmark), for the landmarks `frame` does
-/// not hold. The motion between the two is the one the landmarks both hold agree on
-/// ([`Motion::consensus`], at least [`MIN_INLIERS`]): known identities, not look-alikes, so
-/// no hypothesis is chosen. Each landmark is carried over by the same unambiguous-partner
-/// test a live recognition passes ([`unmapped_partner`]). Run once the drive is over
-/// (`Mapper::finish`), it lets any station that saw a rock speak for a detection of it that
-/// no station recent enough to register against could name.
-pub fn unmapped_rocks_named(frame: &Frame, other: &Frame) -> Vec<(usize, LandmarkId)> {
+/// What another station's frame says of the rocks a station's frame left unmapped
+/// ([`read_unmapped`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct UnmappedReading {
+    /// The unmapped rocks that landmarks of the other frame lie on: (index into
+    /// [`Frame::unmapped`], landmark).
+    pub named: Vec<(usize, LandmarkId)>,
+    /// Every landmark of the other frame that the frame does not hold, against every unmapped
+    /// rock: (index into [`Frame::unmapped`], landmark, whether the motion leaves the two
+    /// placements within each other's reach, so that the landmark may be that rock).
+    pub may_be: Vec<(usize, LandmarkId, bool)>,
+}
+
+/// What station frame `frame`'s unmapped rocks are in another station's frame `other`, for
+/// the landmarks `frame` does not hold; nothing when the two frames fix no motion. The
+/// motion is the one the landmarks both hold agree on ([`Motion::consensus`], at least
+/// [`MIN_INLIERS`]): known identities, not look-alikes, so no hypothesis is chosen. A
+/// landmark names a rock by the same unambiguous-partner test a live recognition passes
+/// ([`unmapped_partner`]). Run once the drive is over (`Mapper::finish`), it lets any
+/// station that saw a rock speak for a detection of it that no station recent enough to
+/// register against could name, and any station that saw a landmark elsewhere rule it out.
+pub fn read_unmapped(frame: &Frame, other: &Frame) -> UnmappedReading {
     let Some(motion) = Motion::consensus(shared_placements(other, frame), MIN_INLIERS) else {
-        return Vec::new();
+        return UnmappedReading::default();
     };
-    other
+    let unheld: Vec<&(LandmarkId, Placed)> = other
         .landmarks
         .iter()
         .filter(|(l, _)| !frame.landmarks.iter().any(|(m, _)| m == l))
+        .collect();
+    let named = unheld
+        .iter()
         .filter_map(|(l, q)| {
             let g = unmapped_partner(&motion, q, frame)?;
             let rock = &frame.unmapped[g];
@@ -111,7 +127,19 @@ pub fn unmapped_rocks_named(frame: &Frame, other: &Frame) -> Vec<(usize, Landmar
                 .all(|o| motion.separation(o, rock).distance > near);
             alone.then_some((g, *l))
         })
-        .collect()
+        .collect();
+    let motion = &motion;
+    let may_be = frame
+        .unmapped
+        .iter()
+        .enumerate()
+        .flat_map(|(g, rock)| {
+            unheld
+                .iter()
+                .map(move |(l, q)| (g, *l, motion.separation(q, rock).within()))
+        })
+        .collect();
+    UnmappedReading { named, may_be }
 }
 
 #[cfg(test)]
@@ -216,8 +244,19 @@ mod tests {
     #[test]
     fn another_frame_names_an_unmapped_rock_by_the_shared_landmarks_motion() {
         assert_eq!(
-            unmapped_rocks_named(&frame(), &other_frame(&[], &[])),
+            read_unmapped(&frame(), &other_frame(&[], &[])).named,
             [(0, 9)]
+        );
+    }
+
+    /// Every landmark the frame does not hold is read against every unmapped rock: the one
+    /// on it may be that rock, one 5 m from it may not.
+    #[test]
+    fn a_landmark_apart_from_an_unmapped_rock_may_not_be_it() {
+        let far = [FIELD[4][0] + 5.0, FIELD[4][1]];
+        assert_eq!(
+            read_unmapped(&frame(), &other_frame(&[(7, far)], &[])).may_be,
+            [(0, 9, true), (0, 7, false)]
         );
     }
 
@@ -227,15 +266,15 @@ mod tests {
     fn a_rival_on_the_rock_or_too_few_shared_landmarks_name_nothing() {
         let beside = [8.15, 8.1];
         assert_eq!(
-            unmapped_rocks_named(&frame(), &other_frame(&[(7, beside)], &[])),
+            read_unmapped(&frame(), &other_frame(&[(7, beside)], &[])).named,
             []
         );
         assert_eq!(
-            unmapped_rocks_named(&frame(), &other_frame(&[], &[beside])),
+            read_unmapped(&frame(), &other_frame(&[], &[beside])).named,
             []
         );
         let mut sparse = other_frame(&[], &[]);
         sparse.landmarks.retain(|(l, _)| *l >= 1);
-        assert_eq!(unmapped_rocks_named(&frame(), &sparse), []);
+        assert_eq!(read_unmapped(&frame(), &sparse), UnmappedReading::default());
     }
 }

@@ -11,9 +11,9 @@ use super::selection;
 use crate::association::audit::{regroup, Regrouping};
 use crate::association::duplicate;
 use crate::association::{
-    agreement, associate, look_alikes, looks_like, reconsider, sketch, unfounded,
-    unmapped_rocks_named, AssociationSettings, Decision, Evidence, Frame, Gallery, LastSeen,
-    Placed, Profile, Recognition, Sketch, StationEvidence, Unfounded,
+    agreement, associate, look_alikes, looks_like, read_unmapped, reconsider, sketch, unfounded,
+    AssociationSettings, Decision, Evidence, Frame, Gallery, LastSeen, Placed, Profile,
+    Recognition, Sketch, StationEvidence, Unfounded, UnmappedReading,
 };
 use crate::calib::Calibration;
 use crate::detection::{Detection, Separation};
@@ -80,6 +80,20 @@ impl Sighted {
             self.frame.unmapped.remove(k);
         }
     }
+}
+
+/// What the other stations' frames say of one rock a station's frame left unmapped
+/// ([`Mapper::frames_naming`]).
+#[derive(Default)]
+struct RockReadings {
+    /// The landmark each frame that names the rock puts on it.
+    names: Vec<LandmarkId>,
+    /// Every landmark the naming frames hold.
+    held: BTreeSet<LandmarkId>,
+    /// Landmarks some frame places apart from the rock, and those some frame places within
+    /// its reach.
+    apart: BTreeSet<LandmarkId>,
+    within: BTreeSet<LandmarkId>,
 }
 
 /// An observation whose association stayed ambiguous, kept to be fused later.
@@ -884,7 +898,7 @@ impl<C: Calculus> Mapper<C> {
     /// over: an observation is fused as the landmark that the frames of [`RECOGNITIONS`] or
     /// more other stations put on it, each by the motion their shared landmarks agree on and
     /// the unambiguous-partner test of a live recognition
-    /// ([`crate::association::unmapped_rocks_named`]), when no frame names another, it may
+    /// ([`read_unmapped`]), when no frame names another, it may
     /// have been that landmark ([`Mapper::may_have_been`]), it is not flat, and the map does
     /// not reject it ([`Mapper::allows`]). A naming that needed the map to rule a rival out
     /// ([`Mapper::frames_naming`]) is not made while an observation touching it at its
@@ -959,48 +973,53 @@ impl<C: Calculus> Mapper<C> {
     }
 
     /// For each of `items`, the landmark that the frames of [`RECOGNITIONS`] or more other
-    /// stations put on it ([`crate::association::unmapped_rocks_named`]), if none puts
-    /// another, and each of its rivals (its candidates and the landmarks it looks like,
-    /// [`look_alikes`]) is fused at its station or held by a naming frame, which places it
-    /// elsewhere. A rival none of them holds may be the rock (colour marsyard s41: a blob of
-    /// two rocks 1.4 m apart, named as the one whose landmark the naming frames held), unless
-    /// the map rejects the observation as that rival (000 §VI-C's test) and the observation's
-    /// range is trusted ([`crate::association::Evidence::range_trusted`]), so that the
-    /// rejection does not rest on a ground cue alone (colour marsyard s13: the lit top of a
-    /// rock at 1.7 m, read as standing at 2.6 m, named against a rival rejected through that
-    /// range made the map unsound). Stereo where no ground cue applies measures the rock
-    /// itself: trusting it too named 23 more observations on colour marsyard s7 (87.3 → 89.9 %
-    /// fused) and raised the fused share of 37 of 48 sets by 0.1–2.5 points, lowering none,
-    /// with no relation unsound (stop 81, docs/RUN.md). With each landmark, whether the map had
-    /// to rule out a rival.
+    /// stations put on it ([`read_unmapped`]), if none puts another, and each of its rivals
+    /// (its candidates and the landmarks it looks like, [`look_alikes`]) is fused at its
+    /// station or held by a naming frame, which places it elsewhere. A rival none of them
+    /// holds may be the rock (colour marsyard s41: a blob of two rocks 1.4 m apart, named as
+    /// the one whose landmark the naming frames held), unless the observation's range is
+    /// trusted ([`crate::association::Evidence::range_trusted`]) and the map rejects the
+    /// observation as that rival (000 §VI-C's test) or another station's frame places the
+    /// rival apart from the rock, by the motion their shared landmarks agree on, and none
+    /// within its reach. The placements and the map's test both rest on the observation's
+    /// range, so a ground cue alone does not do (colour marsyard s13: the lit top of a rock
+    /// at 1.7 m, read as standing at 2.6 m, named against a rival so ruled out made the map
+    /// unsound, by the map at stop 79 and by the frames at stop 82). Stereo where no ground
+    /// cue applies measures the rock itself (stop 81). Ruling rivals out by the frames too
+    /// named 0.9–4.4 points more of the correct detections on 26 of 27 luminance sets
+    /// (docs/RUN.md, stop 82); stop 76 measured it without the trusted range and lost purity
+    /// to blobs named as a neighbour. With each landmark, whether the map rejected a rival
+    /// (then an observation touching it may be the rock: [`Mapper::recognise_given_up`]).
     fn frames_naming<'a>(
         &self,
         items: impl Iterator<Item = &'a HeldBack> + Clone,
     ) -> Vec<Option<(LandmarkId, bool)>> {
         let stations: BTreeSet<usize> = items.clone().map(|item| item.station).collect();
-        // (station, unmapped rock of its frame) → the landmarks other frames put on it, and
-        // every landmark those frames hold.
-        let mut named: BTreeMap<(usize, usize), (Vec<LandmarkId>, BTreeSet<LandmarkId>)> =
-            BTreeMap::new();
+        let mut readings: BTreeMap<(usize, usize), RockReadings> = BTreeMap::new();
         for sighted in self
             .sighted
             .iter()
             .filter(|s| stations.contains(&s.station))
         {
-            let found: Vec<(&Frame, Vec<(usize, LandmarkId)>)> = self
+            let found: Vec<(&Frame, UnmappedReading)> = self
                 .sighted
                 .par_iter()
                 .filter(|other| other.station != sighted.station)
-                .map(|other| {
-                    let names = unmapped_rocks_named(&sighted.frame, &other.frame);
-                    (&other.frame, names)
-                })
+                .map(|other| (&other.frame, read_unmapped(&sighted.frame, &other.frame)))
                 .collect();
-            for (other, names) in found {
-                for (g, l) in names {
-                    let entry = named.entry((sighted.station, g)).or_default();
-                    entry.0.push(l);
-                    entry.1.extend(other.landmarks.iter().map(|m| m.0));
+            for (other, reading) in found {
+                for (g, l) in reading.named {
+                    let rock = readings.entry((sighted.station, g)).or_default();
+                    rock.names.push(l);
+                    rock.held.extend(other.landmarks.iter().map(|m| m.0));
+                }
+                for (g, l, may_be) in reading.may_be {
+                    let rock = readings.entry((sighted.station, g)).or_default();
+                    if may_be {
+                        rock.within.insert(l);
+                    } else {
+                        rock.apart.insert(l);
+                    }
                 }
             }
         }
@@ -1009,15 +1028,12 @@ impl<C: Calculus> Mapper<C> {
                 let sighted = self.sighted.iter().find(|s| s.station == item.station)?;
                 let placed = item.evidence.placed?;
                 let g = sighted.frame.unmapped.iter().position(|&u| u == placed)?;
-                let (names, held) = named.get(&(item.station, g))?;
-                let l = names[0];
-                if names.len() < RECOGNITIONS || names.iter().any(|&m| m != l) {
+                let rock = readings.get(&(item.station, g))?;
+                let l = *rock.names.first()?;
+                if rock.names.len() < RECOGNITIONS || rock.names.iter().any(|&m| m != l) {
                     return None;
                 }
-                let accounted = |r: LandmarkId| {
-                    r == l || held.contains(&r) || item.decided.iter().any(|d| d.landmark == r)
-                };
-                let mut rivals = item
+                let rivals: BTreeSet<LandmarkId> = item
                     .candidates
                     .iter()
                     .copied()
@@ -1026,12 +1042,18 @@ impl<C: Calculus> Mapper<C> {
                         &self.gallery,
                         &self.association,
                     ))
-                    .filter(|&r| !accounted(r))
-                    .peekable();
-                let by_map = rivals.peek().is_some();
-                let ruled_out =
-                    rivals.all(|r| item.evidence.range_trusted && !self.allows(item, r));
-                ruled_out.then_some((l, by_map))
+                    .filter(|&r| {
+                        r != l
+                            && !rock.held.contains(&r)
+                            && !item.decided.iter().any(|d| d.landmark == r)
+                    })
+                    .collect();
+                let placed_apart =
+                    |r: LandmarkId| rock.apart.contains(&r) && !rock.within.contains(&r);
+                let ruled_out = rivals.iter().all(|&r| {
+                    item.evidence.range_trusted && (placed_apart(r) || !self.allows(item, r))
+                });
+                ruled_out.then(|| (l, rivals.iter().any(|&r| !self.allows(item, r))))
             })
             .collect()
     }
@@ -1900,6 +1922,15 @@ mod tests {
 
         let mut mapper = test_mapper();
         let k = given_up_with_a_rival_only_the_map_rejects(&mut mapper, true);
+        hold_one_touching(&mut mapper, k);
+        mapper.finish();
+        assert!(mapper.recognised_at_end.is_empty());
+        assert!(mapper.given_up.iter().any(|item| item.detection == k));
+    }
+
+    /// Holds back at station 2, beside the given-up observation at position `k`, one whose box
+    /// touches it, with landmark 15 for its only candidate.
+    fn hold_one_touching(mapper: &mut Mapper<Edc>, k: usize) {
         let mut beside = mapper.given_up[0].clone();
         mapper.given_up[0].bbox = [100, 50, 120, 60];
         beside.bbox = [122, 52, 140, 62];
@@ -1907,9 +1938,75 @@ mod tests {
         beside.candidates = vec![15];
         beside.evidence.placed = None;
         mapper.held.push(beside);
+    }
+
+    /// A rival the map rejects leaves the naming to the map even where another frame places
+    /// it apart too (station 5's, which does not hold 15): beside a contested observation it
+    /// stands.
+    #[test]
+    fn a_rival_the_map_rejects_and_a_frame_places_apart_stands_beside_a_contested_observation() {
+        let mut mapper = test_mapper();
+        let k = given_up_with_a_rival_only_the_map_rejects(&mut mapper, true);
+        fuse_unchecked(&mut mapper, 5, &seen(5, STATIONS), |r| r as LandmarkId);
+        let frame = &mut mapper.sighted.last_mut().expect("just fused").frame;
+        frame.landmarks.retain(|&(l, _)| l != 15);
+        assert!(frame.landmarks.iter().any(|&(l, _)| l == 7));
+        hold_one_touching(&mut mapper, k);
         mapper.finish();
         assert!(mapper.recognised_at_end.is_empty());
         assert!(mapper.given_up.iter().any(|item| item.detection == k));
+    }
+
+    /// The observation given up at station 2 with landmarks 15 and 99 for candidates, 99 a
+    /// landmark the map does not reject it as and no naming frame holds: the frames of
+    /// stations 5 and on, which do not hold 15, hold it as placed in `rival` (each in its
+    /// station's coordinates; rock 15 lies at (5 − station, 1.5)). Returns its position.
+    fn given_up_with_a_rival_later_frames_hold(
+        mapper: &mut Mapper<Edc>,
+        rival: &[Placed],
+        range_trusted: bool,
+    ) -> usize {
+        let k = given_up_at_station_2(mapper, vec![15, 99]);
+        for (step, &at) in (5..).zip(rival) {
+            fuse_unchecked(mapper, step, &seen(step, STATIONS), |r| r as LandmarkId);
+            let frame = &mut mapper.sighted.last_mut().expect("just fused").frame;
+            frame.landmarks.retain(|&(l, _)| l != 15);
+            frame.landmarks.push((99, at));
+        }
+        mapper.given_up[0].evidence.range_trusted = range_trusted;
+        assert!(mapper.allows(&mapper.given_up[0], 99));
+        k
+    }
+
+    /// 6 m from rock 15, seen from station 5.
+    fn apart() -> Placed {
+        Placed::disc([-2.0, -6.0], 0.3)
+    }
+
+    /// A rival that another station's frame places apart from the rock is not the rock, when
+    /// the observation's range is trusted: the frames' naming stands.
+    #[test]
+    fn a_rival_another_frame_places_apart_rules_itself_out_for_an_observation_whose_range_is_trusted(
+    ) {
+        let mut mapper = test_mapper();
+        let k = given_up_with_a_rival_later_frames_hold(&mut mapper, &[apart()], true);
+        mapper.finish();
+        assert_named_15_at_end(&mapper, k);
+        assert_eq!(unsound(&mapper.map, |l| l as usize), 0);
+    }
+
+    /// Not on a range that may be wrong, nor where another frame places the rival within the
+    /// rock's reach (station 6, too loosely to name the rock).
+    #[test]
+    fn a_rival_placed_apart_from_an_untrusted_range_or_also_within_reach_stands() {
+        let within = Placed::disc([-0.5, 1.5], 2.5);
+        for (rival, range_trusted) in [(vec![apart()], false), (vec![apart(), within], true)] {
+            let mut mapper = test_mapper();
+            given_up_with_a_rival_later_frames_hold(&mut mapper, &rival, range_trusted);
+            mapper.finish();
+            assert!(mapper.recognised_at_end.is_empty(), "{rival:?}");
+            assert_eq!(mapper.given_up.len(), 1);
+        }
     }
 
     /// Rock 15's detection at station 2 as a piece that matched no landmark and founded none,
