@@ -91,8 +91,8 @@ pub struct UnmappedReading {
     pub may_be: Vec<(usize, LandmarkId, bool)>,
 }
 
-/// What station frame `frame`'s unmapped rocks are in another station's frame `other`, for
-/// the landmarks `frame` does not hold; nothing when the two frames fix no motion. The
+/// What another station's frame `other` says of station frame `frame`'s unmapped rocks,
+/// through the landmarks `frame` does not hold; nothing when the two fix no motion. The
 /// motion is the one the landmarks both hold agree on ([`Motion::consensus`], at least
 /// [`MIN_INLIERS`]): known identities, not look-alikes, so no hypothesis is chosen. A
 /// landmark names a rock by the same unambiguous-partner test a live recognition passes
