@@ -29,7 +29,7 @@ pub struct Regrouping {
 /// fused, if two of them disagree on where it is ([`witness`]). Sightings that agree, directly
 /// or through others, show one rock; the largest such set keeps the landmark, and a set that
 /// disagrees with every group so far starts another. A set that disagrees with itself leaves
-/// the map, or only its outlier does, when it has one (`outliers`). A sighting no other
+/// the map, or only its outliers do, when it has them (`outliers`). A sighting no other
 /// station can witness goes with the nearest one in time that is witnessed: association
 /// tracked it from there.
 pub fn regroup(landmark: LandmarkId, sightings: &[(usize, &Frame)]) -> Option<Regrouping> {
@@ -127,19 +127,24 @@ pub fn regroup(landmark: LandmarkId, sightings: &[(usize, &Frame)]) -> Option<Re
 /// them, to be retired alone as an outlier ([`outliers`]).
 const OUTLIER_DISAGREEMENTS: usize = 2;
 
-/// The sightings (indices) that alone take part in every disagreement inside their group
-/// (`component`, under agreement), at least [`OUTLIER_DISAGREEMENTS`] of them: one sighting
-/// that disagrees with several others that agree with each other is what is wrong, and it
-/// leaves the map alone rather than with the whole group. Retiring whole groups threw away
-/// far more right sightings than wrong ones: over the 25 sets of stop 67, marsyard seed 3's
-/// landmark 1 lost 44 stations' sightings of rock 19 for one sighting (station 21) that three
-/// others disagreed with; grayscale marsyard seed 3's landmark 8, 8 of rock 28 for the one of
-/// rock 1. In three of the four such groups the outlier was the wrong sighting (a 26 000-pixel
-/// blob of shadow under rock 19 recognised as its landmark, rock 1's sighting, a blob over
-/// three rocks), in the fourth a small far sighting of the right rock. A single disagreement
-/// says nothing of which side is wrong (in 5 of 8 such groups the two sightings were of
-/// different rocks, with up to 7 more wrong sightings that agreed with the rest, as in a pile
-/// of rocks a metre apart), so its group still leaves the map whole.
+/// The sightings (indices) retired alone from their group (`component`, under agreement)
+/// rather than with it: the one that takes part in every disagreement inside the group, at
+/// least [`OUTLIER_DISAGREEMENTS`] of them, or both sightings of the group's only
+/// disagreement. One sighting that disagrees with several others that agree with each other
+/// is what is wrong. Retiring whole groups threw away far more right sightings than wrong
+/// ones: over the 25 sets of stop 67, marsyard seed 3's landmark 1 lost 44 stations'
+/// sightings of rock 19 for one sighting (station 21) that three others disagreed with;
+/// grayscale marsyard seed 3's landmark 8, 8 of rock 28 for the one of rock 1. In three of
+/// the four such groups the outlier was the wrong sighting (a 26 000-pixel blob of shadow
+/// under rock 19 recognised as its landmark, rock 1's sighting, a blob over three rocks), in
+/// the fourth a small far sighting of the right rock. A single disagreement says nothing of
+/// which side is wrong, so both leave. At stop 67 the group left with them (in 5 of 8 such
+/// groups the two sightings were of different rocks, with up to 7 more wrong sightings that
+/// agreed with the rest); by stop 82 association mixed far less, and 10 of 13 groups retired
+/// whole on one or two disagreements held one rock only (colour marsyard s67: 16 sightings of
+/// rock 14 for one disagreement against 119 agreements). Retiring the pair alone raised the
+/// fused share of 10 of 53 sets by 0.4–5.2 points with no relation unsound (docs/RUN.md, stop
+/// 82).
 fn outliers(component: &[usize], disagree: &[(usize, usize)]) -> Vec<usize> {
     let mut groups: Vec<usize> = disagree
         .iter()
@@ -150,20 +155,25 @@ fn outliers(component: &[usize], disagree: &[(usize, usize)]) -> Vec<usize> {
     groups.dedup();
     groups
         .into_iter()
-        .filter_map(|c| {
+        .flat_map(|c| {
             let inside: Vec<(usize, usize)> = disagree
                 .iter()
                 .copied()
                 .filter(|&(a, _)| component[a] == c)
                 .filter(|&(a, b)| component[a] == component[b])
                 .collect();
-            if inside.len() < OUTLIER_DISAGREEMENTS {
-                return None;
-            }
             let (a, b) = inside[0];
+            if inside.len() == 1 {
+                return vec![a, b];
+            }
+            if inside.len() < OUTLIER_DISAGREEMENTS {
+                return Vec::new();
+            }
             [a, b]
                 .into_iter()
                 .find(|&x| inside.iter().all(|&(p, q)| p == x || q == x))
+                .into_iter()
+                .collect()
         })
         .collect()
 }
@@ -258,13 +268,10 @@ mod tests {
         assert_eq!(regroup(0, &sightings_of(0, &frames)), None);
     }
 
-    /// Stations 8–12 all see rock A. Station 10 places it 1 m off: near enough to agree with
-    /// the loose placements of stations 8 and 9, too far for the tight ones of 11 and 12,
-    /// which agree with 8 and 9. Station 10's sighting alone takes part in both
-    /// disagreements, and leaves the map alone; the others keep the landmark.
-    #[test]
-    fn one_sighting_that_several_disagree_with_is_retired_alone() {
-        let frames: Vec<(usize, Frame)> = (8..=12)
+    /// Stations 8–12 seeing rock A, each station's frame placing it as `placed` says from its
+    /// true place (`[x, y]`, station coordinates).
+    fn rock_a_placed(placed: impl Fn(usize, [f64; 2]) -> Placed) -> Vec<(usize, Frame)> {
+        (8..=12)
             .map(|step| {
                 let mut frame = seen(step, usize::MAX).frame(|r| r as LandmarkId);
                 let a = frame
@@ -272,28 +279,55 @@ mod tests {
                     .iter_mut()
                     .find(|m| m.0 == A as LandmarkId)
                     .expect("rock A within 8 m");
-                let [x, y] = a.1.point;
-                a.1 = match step {
-                    8 | 9 => Placed::disc([x, y], 1.2),
-                    10 => Placed::disc([x, y + 1.0], 0.3),
-                    _ => Placed::disc([x, y], 0.2),
-                };
+                a.1 = placed(step, a.1.point);
                 (step, frame)
             })
-            .collect();
+            .collect()
+    }
+
+    /// Station 10 places rock A 1 m off: near enough to agree with the loose placements of
+    /// stations 8 and 9, too far for the tight ones of 11 and 12, which agree with 8 and 9.
+    /// Station 10's sighting alone takes part in both disagreements, and leaves the map
+    /// alone; the others keep the landmark.
+    #[test]
+    fn one_sighting_that_several_disagree_with_is_retired_alone() {
+        let frames = rock_a_placed(|step, [x, y]| match step {
+            8 | 9 => Placed::disc([x, y], 1.2),
+            10 => Placed::disc([x, y + 1.0], 0.3),
+            _ => Placed::disc([x, y], 0.2),
+        });
         let regrouping = regroup(A as LandmarkId, &sightings_of(A as LandmarkId, &frames))
             .expect("10 disagrees");
         assert_eq!(regrouping.retired, vec![10]);
         assert_eq!(regrouping.groups, vec![vec![8, 9, 11, 12]]);
     }
 
+    /// Station 10 places rock A 1 m off again, now with station 11's placement loose as well:
+    /// only station 12's disagrees with it. The group's only disagreement cannot say which of
+    /// 10 and 12 is wrong; both leave the map, and the others keep the landmark.
+    #[test]
+    fn the_two_sightings_of_a_groups_only_disagreement_are_retired_alone() {
+        let frames = rock_a_placed(|step, [x, y]| match step {
+            10 => Placed::disc([x, y + 1.0], 0.3),
+            12 => Placed::disc([x, y], 0.2),
+            _ => Placed::disc([x, y], 1.2),
+        });
+        let regrouping = regroup(A as LandmarkId, &sightings_of(A as LandmarkId, &frames))
+            .expect("10 and 12 disagree");
+        assert_eq!(regrouping.retired, vec![10, 12]);
+        assert_eq!(regrouping.groups, vec![vec![8, 9, 11]]);
+    }
+
     #[test]
     fn outliers_take_part_in_every_disagreement_of_their_group() {
         // Nodes 0–4 agree; 2 disagrees with 0 and 4; 5 and 6 agree and disagree once.
         let component = [0, 0, 0, 0, 0, 5, 5];
-        assert_eq!(outliers(&component, &[(0, 2), (2, 4), (5, 6)]), vec![2]);
+        assert_eq!(
+            outliers(&component, &[(0, 2), (2, 4), (5, 6)]),
+            vec![2, 5, 6]
+        );
         assert_eq!(outliers(&component, &[(0, 2), (1, 4)]), Vec::<usize>::new());
-        assert_eq!(outliers(&component, &[(0, 2)]), Vec::<usize>::new());
+        assert_eq!(outliers(&component, &[(0, 2)]), vec![0, 2]);
     }
 
     #[test]
