@@ -140,9 +140,9 @@ const OUTLIER_DISAGREEMENTS: usize = 2;
 /// the fourth a small far sighting of the right rock. A single disagreement says nothing of
 /// which side is wrong, so both leave. At stop 67 the group left with them (in 5 of 8 such
 /// groups the two sightings were of different rocks, with up to 7 more wrong sightings that
-/// agreed with the rest); by stop 82 association mixed far less, and 10 of 13 groups retired
-/// whole on one or two disagreements held one rock only (colour marsyard s67: 16 sightings of
-/// rock 14 for one disagreement against 119 agreements). Retiring the pair alone raised the
+/// agreed with the rest); by stop 82 association mixed far less, and 13 of the 18 landmarks
+/// retired whole over 53 sets held one rock only (colour marsyard s67: 16 sightings of rock
+/// 14 for one disagreement against 119 agreements). Retiring the pair alone raised the
 /// fused share of 10 of 53 sets by 0.4–5.2 points with no relation unsound (docs/RUN.md, stop
 /// 82).
 fn outliers(component: &[usize], disagree: &[(usize, usize)]) -> Vec<usize> {
