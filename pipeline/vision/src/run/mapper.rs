@@ -1051,10 +1051,17 @@ impl<C: Calculus> Mapper<C> {
                     .collect();
                 let placed_apart =
                     |r: LandmarkId| rock.apart.contains(&r) && !rock.within.contains(&r);
+                // The map's test of each rival runs once: whether it rejects any says how the
+                // naming was made, whether or not a frame places that rival apart too.
+                let mut rejected_any = false;
                 let ruled_out = rivals.iter().all(|&r| {
-                    item.evidence.range_trusted && (placed_apart(r) || !self.allows(item, r))
+                    item.evidence.range_trusted && {
+                        let rejected = !self.allows(item, r);
+                        rejected_any |= rejected;
+                        placed_apart(r) || rejected
+                    }
                 });
-                ruled_out.then(|| (l, rivals.iter().any(|&r| !self.allows(item, r))))
+                ruled_out.then_some((l, rejected_any))
             })
             .collect()
     }
