@@ -880,6 +880,17 @@ impl Registration {
 /// than an anchor ([`ANCHOR_RADIUS_M`]), within the pair's separation, and every landmark and
 /// every other unmapped rock of the frame clearly farther from `p`.
 pub(super) fn unmapped_partner(motion: &Motion, p: &Placed, frame: &Frame) -> Option<usize> {
+    partner_among(motion, p, frame, |_, _| true)
+}
+
+/// [`unmapped_partner`] with a narrower crowd: a landmark or another unmapped rock `o` of the
+/// frame counts only where `crowds(o, is_landmark)` says.
+pub(super) fn partner_among(
+    motion: &Motion,
+    p: &Placed,
+    frame: &Frame,
+    crowds: impl Fn(&Placed, bool) -> bool,
+) -> Option<usize> {
     if p.reach() > ANCHOR_RADIUS_M {
         return None;
     }
@@ -889,21 +900,20 @@ pub(super) fn unmapped_partner(motion: &Motion, p: &Placed, frame: &Frame) -> Op
         .enumerate()
         .map(|(g, q)| (g, motion.separation(p, q)))
         .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))?;
+    let rock = &frame.unmapped[g];
     let near = UNIQUE * separation.distance + SLACK_M;
-    let alone = frame
-        .landmarks
+    let landmarks = frame.landmarks.iter().map(|m| (&m.1, true));
+    let unmapped = frame
+        .unmapped
         .iter()
-        .map(|m| &m.1)
-        .chain(
-            frame
-                .unmapped
-                .iter()
-                .enumerate()
-                .filter(|&(k, _)| k != g)
-                .map(|(_, o)| o),
-        )
-        .all(|o| motion.separation(p, o).distance > near);
-    (separation.within() && frame.unmapped[g].reach() <= ANCHOR_RADIUS_M && alone).then_some(g)
+        .enumerate()
+        .filter(|&(k, _)| k != g)
+        .map(|(_, o)| (o, false));
+    let alone = landmarks
+        .chain(unmapped)
+        .filter(|&(o, is_landmark)| crowds(o, is_landmark))
+        .all(|(o, _)| motion.separation(p, o).distance > near);
+    (separation.within() && rock.reach() <= ANCHOR_RADIUS_M && alone).then_some(g)
 }
 
 /// Whether the frame's rock `g` lies where `motion` puts the placement `p`, and no placement
