@@ -123,28 +123,23 @@ pub fn regroup(landmark: LandmarkId, sightings: &[(usize, &Frame)]) -> Option<Re
     })
 }
 
-/// Fewest disagreements inside a group that one sighting must take part in, every one of
-/// them, to be retired alone as an outlier ([`outliers`]).
-const OUTLIER_DISAGREEMENTS: usize = 2;
-
 /// The sightings (indices) retired alone from their group (`component`, under agreement)
-/// rather than with it: the one that takes part in every disagreement inside the group, at
-/// least [`OUTLIER_DISAGREEMENTS`] of them, or both sightings of the group's only
-/// disagreement. One sighting that disagrees with several others that agree with each other
-/// is what is wrong. Retiring whole groups threw away far more right sightings than wrong
-/// ones: over the 25 sets of stop 67, marsyard seed 3's landmark 1 lost 44 stations'
-/// sightings of rock 19 for one sighting (station 21) that three others disagreed with;
-/// grayscale marsyard seed 3's landmark 8, 8 of rock 28 for the one of rock 1. In three of
-/// the four such groups the outlier was the wrong sighting (a 26 000-pixel blob of shadow
-/// under rock 19 recognised as its landmark, rock 1's sighting, a blob over three rocks), in
-/// the fourth a small far sighting of the right rock. A single disagreement says nothing of
-/// which side is wrong, so both leave. At stop 67 the group left with them (in 5 of 8 such
-/// groups the two sightings were of different rocks, with up to 7 more wrong sightings that
-/// agreed with the rest); by stop 82 association mixed far less, and 13 of the 18 landmarks
-/// retired whole over 53 sets held one rock only (colour marsyard s67: 16 sightings of rock
-/// 14 for one disagreement against 119 agreements). Retiring the pair alone raised the
-/// fused share of 10 of 53 sets by 0.4–5.2 points with no relation unsound (docs/RUN.md, stop
-/// 82).
+/// rather than with it: the one that takes part in every disagreement inside the group, when
+/// there are several, or both sightings of the group's only disagreement. One sighting that
+/// disagrees with several others that agree with each other is what is wrong. Retiring whole
+/// groups threw away far more right sightings than wrong ones: over the 25 sets of stop 67,
+/// marsyard seed 3's landmark 1 lost 44 stations' sightings of rock 19 for one sighting
+/// (station 21) that three others disagreed with; grayscale marsyard seed 3's landmark 8, 8 of
+/// rock 28 for the one of rock 1. In three of the four such groups the outlier was the wrong
+/// sighting (a 26 000-pixel blob of shadow under rock 19 recognised as its landmark, rock 1's
+/// sighting, a blob over three rocks), in the fourth a small far sighting of the right rock.
+/// A single disagreement says nothing of which side is wrong, so both leave. At stop 67 the
+/// group left with them (in 5 of 8 such groups the two sightings were of different rocks,
+/// with up to 7 more wrong sightings that agreed with the rest); by stop 82 association mixed
+/// far less, and 13 of the 18 landmarks retired whole over 53 sets held one rock only (colour
+/// marsyard s67: 16 sightings of rock 14 for one disagreement against 119 agreements).
+/// Retiring the pair alone raised the fused share of 10 of 53 sets by 0.4–5.2 points with no
+/// relation unsound (docs/RUN.md, stop 82).
 fn outliers(component: &[usize], disagree: &[(usize, usize)]) -> Vec<usize> {
     let mut groups: Vec<usize> = disagree
         .iter()
@@ -165,9 +160,6 @@ fn outliers(component: &[usize], disagree: &[(usize, usize)]) -> Vec<usize> {
             let (a, b) = inside[0];
             if inside.len() == 1 {
                 return vec![a, b];
-            }
-            if inside.len() < OUTLIER_DISAGREEMENTS {
-                return Vec::new();
             }
             [a, b]
                 .into_iter()
