@@ -909,10 +909,12 @@ pub(super) fn partner_among(
         .enumerate()
         .filter(|&(k, _)| k != g)
         .map(|(_, o)| (o, false));
+    // `crowds` is asked only of placements near enough to crowd: at the end of the drive
+    // it is a pass over the other frame's placements.
     let alone = landmarks
         .chain(unmapped)
-        .filter(|&(o, is_landmark)| crowds(o, is_landmark))
-        .all(|(o, _)| motion.separation(p, o).distance > near);
+        .filter(|&(o, _)| motion.separation(p, o).distance <= near)
+        .all(|(o, is_landmark)| !crowds(o, is_landmark));
     (separation.within() && rock.reach() <= ANCHOR_RADIUS_M && alone).then_some(g)
 }
 
